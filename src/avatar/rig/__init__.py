@@ -1,0 +1,1 @@
+"""Rigs: skeletons placed on the shaped mesh, kinematics and skinning."""

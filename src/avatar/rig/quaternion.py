@@ -1,0 +1,127 @@
+"""Quaternion maths on arrays, (w, x, y, z), batch dimensions leading."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b, shapes (..., 4)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+
+
+def conjugate(q: np.ndarray) -> np.ndarray:
+    """Inverse of a unit quaternion, (..., 4)."""
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def to_matrix(q: np.ndarray) -> np.ndarray:
+    """(..., 4) unit quaternions -> (..., 3, 3) rotation matrices."""
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(q.shape[:-1] + (3, 3))  # fmt: skip
+
+
+def from_matrix(m: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0."""
+    m = np.asarray(m, dtype=np.float64)
+    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
+    # Four candidate solutions; pick, per matrix, the one with the largest pivot (stable).
+    cands = np.stack(
+        [
+            np.stack([1 + m00 + m11 + m22, m[..., 2, 1] - m[..., 1, 2],
+                      m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], -1),
+            np.stack([m[..., 2, 1] - m[..., 1, 2], 1 + m00 - m11 - m22,
+                      m[..., 0, 1] + m[..., 1, 0], m[..., 0, 2] + m[..., 2, 0]], -1),
+            np.stack([m[..., 0, 2] - m[..., 2, 0], m[..., 0, 1] + m[..., 1, 0],
+                      1 - m00 + m11 - m22, m[..., 1, 2] + m[..., 2, 1]], -1),
+            np.stack([m[..., 1, 0] - m[..., 0, 1], m[..., 0, 2] + m[..., 2, 0],
+                      m[..., 1, 2] + m[..., 2, 1], 1 - m00 - m11 + m22], -1),
+        ],
+        axis=-2,
+    )  # fmt: skip
+    pivot = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22,
+                      1 - m00 - m11 + m22], -1)  # fmt: skip
+    best = np.argmax(pivot, axis=-1)
+    q = np.take_along_axis(cands, best[..., None, None], axis=-2)[..., 0, :]
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Rotation of ``angle`` radians (...,) about unit ``axis`` (..., 3) -> (..., 4)."""
+    axis = np.asarray(axis, dtype=np.float64)
+    half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
+    axis = axis / np.maximum(np.linalg.norm(axis, axis=-1, keepdims=True), 1e-300)
+    return np.concatenate([np.cos(half), np.sin(half) * axis], axis=-1)
+
+
+_AXIS = {"X": 0, "Y": 1, "Z": 2}
+
+
+def from_euler(angles: np.ndarray, order: str = "XYZ") -> np.ndarray:
+    """Euler angles (..., 3) in radians -> quaternions (..., 4).
+
+    ``order`` is Blender's/BVH's: "XYZ" means rotate about X first, then Y, then Z in a
+    fixed frame (R = Rz @ Ry @ Rx); ``angles[..., i]`` is the angle about ``order[i]``.
+    """
+    angles = np.asarray(angles, dtype=np.float64)
+    q = None
+    for i, letter in enumerate(order.upper()):
+        axis = np.zeros(3)
+        axis[_AXIS[letter]] = 1.0
+        qi = from_axis_angle(np.broadcast_to(axis, angles.shape), angles[..., i])
+        q = qi if q is None else multiply(qi, q)
+    assert q is not None
+    return q
+
+
+def to_euler(q: np.ndarray, order: str = "XYZ") -> np.ndarray:
+    """Quaternions (..., 4) -> Euler angles (..., 3) for the convention of ``from_euler``."""
+    m = to_matrix(q)
+    i, j, k = (_AXIS[c] for c in order.upper())
+    # R = R_k R_j R_i; sign of the permutation decides the formula's signs.
+    sign = 1.0 if (i, j, k) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
+    sj = np.clip(-sign * m[..., k, i], -1.0, 1.0)
+    a_j = np.arcsin(sj)
+    a_i = np.arctan2(sign * m[..., k, j], m[..., k, k])
+    a_k = np.arctan2(sign * m[..., j, i], m[..., i, i])
+    gimbal = np.abs(sj) > 1 - 1e-9
+    if np.any(gimbal):
+        a_i = np.where(gimbal, 0.0, a_i)
+        a_k = np.where(gimbal, np.arctan2(-sign * m[..., i, j], m[..., j, j]), a_k)
+    out = np.empty(q.shape[:-1] + (3,))
+    out[..., 0], out[..., 1], out[..., 2] = a_i, a_j, a_k
+    return out
+
+
+def slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Spherical interpolation between unit quaternions (..., 4) at t (...,)."""
+    t = np.asarray(t, dtype=np.float64)[..., None]
+    dot = np.sum(a * b, axis=-1, keepdims=True)
+    b = np.where(dot < 0, -b, b)
+    dot = np.abs(dot)
+    theta = np.arccos(np.clip(dot, -1.0, 1.0))
+    small = theta < 1e-6
+    s = np.sin(np.where(small, 1.0, theta))
+    wa = np.where(small, 1 - t, np.sin((1 - t) * theta) / s)
+    wb = np.where(small, t, np.sin(t * theta) / s)
+    out = wa * a + wb * b
+    return out / np.linalg.norm(out, axis=-1, keepdims=True)
