@@ -1,0 +1,77 @@
+"""Animation record -> Blender action on an armature (Blender 4.4+ slotted actions).
+
+Keyframes are written as whole arrays with ``foreach_set`` (about 6x faster than
+``keyframe_insert``), one F-curve per quaternion/location channel, linear interpolation
+because the record is already sampled once per frame.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from bpy_extras import anim_utils
+
+from avatar.rig.skeleton import Animation
+
+_LINEAR = 1  # Keyframe.interpolation enum value of 'LINEAR'
+
+
+def apply_animation(
+    armature_obj: bpy.types.Object,
+    animation: Animation,
+    name: str = "Avatar motion",
+    frame_start: int = 1,
+    scene: bpy.types.Scene | None = None,
+) -> bpy.types.Action:
+    """Create an action from ``animation`` and assign it to ``armature_obj``.
+
+    animation.rotations (T, J, 4) wxyz and translations (T, J, 3) become the pose bones'
+    ``rotation_quaternion`` and ``location`` at frames frame_start .. frame_start + T - 1.
+    Bones of the animation missing from the armature are skipped. The scene's frame range
+    and fps are set to the clip's.
+    """
+    action = bpy.data.actions.new(name)
+    slot = action.slots.new(id_type="OBJECT", name=armature_obj.name)
+    armature_obj.animation_data_create()
+    armature_obj.animation_data.action = action
+    armature_obj.animation_data.action_slot = slot
+    channelbag = anim_utils.action_ensure_channelbag_for_slot(action, slot)
+    frames = frame_start + np.arange(animation.frames, dtype=np.float32)
+    for j, bone in enumerate(animation.bone_names):
+        pose_bone = armature_obj.pose.bones.get(bone)
+        if pose_bone is None:
+            continue
+        pose_bone.rotation_mode = "QUATERNION"
+        group = channelbag.groups.new(bone)
+        _write_channels(channelbag, group, bone, "rotation_quaternion",
+                        frames, animation.rotations[:, j])  # fmt: skip
+        if np.any(animation.translations[:, j]):
+            _write_channels(channelbag, group, bone, "location",
+                            frames, animation.translations[:, j])  # fmt: skip
+    set_frame_range(scene or bpy.context.scene, frame_start, animation.frames, animation.fps)
+    return action
+
+
+def _write_channels(channelbag, group, bone: str, prop: str, frames, values) -> None:
+    """values: (T, C) -> C F-curves ``pose.bones[bone].prop[c]`` keyed at ``frames`` (T,)."""
+    path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{prop}'
+    count = len(frames)
+    for c in range(values.shape[1]):
+        curve = channelbag.fcurves.new(path, index=c)
+        curve.group = group
+        points = curve.keyframe_points
+        points.add(count)
+        co = np.empty((count, 2), dtype=np.float32)
+        co[:, 0], co[:, 1] = frames, values[:, c]
+        points.foreach_set("co", co.ravel())
+        points.foreach_set("interpolation", np.full(count, _LINEAR, dtype=np.int32))
+        curve.update()
+
+
+def set_frame_range(scene: bpy.types.Scene, start: int, count: int, fps: float) -> None:
+    """Scene frames start .. start + count - 1 at ``fps`` (fractional rates via fps_base)."""
+    scene.frame_start = start
+    scene.frame_end = start + max(count, 1) - 1
+    rounded = max(1, round(fps))
+    scene.render.fps = rounded
+    scene.render.fps_base = rounded / fps
