@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from avatar.mesh import Mesh
-from avatar.rig import quaternion
 from avatar.rig.skeleton import Animation, Skeleton
 
 
@@ -65,4 +64,26 @@ def identity_quaternions(frames: int, joints: int) -> np.ndarray:
     return q
 
 
-__all__ = ["quaternion", "skeleton", "random_animation", "grid_mesh", "identity_quaternions"]
+def box_mesh(lo, hi) -> Mesh:
+    """An axis-aligned box of 6 outward-facing quads with a simple UV per corner."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    verts = np.array(
+        [[x, y, z] for z in (z0, z1) for y in (y0, y1) for x in (x0, x1)], dtype=np.float32
+    )
+    faces = np.array(
+        [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]],
+        dtype=np.int32,
+    )
+    uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float32)
+    return Mesh(verts, faces, uvs, np.tile(np.arange(4, dtype=np.int32), (6, 1)))
+
+
+def figure(rng: np.random.Generator, name: str = "figure"):
+    """A skinned box on a random skeleton: a minimal Character for render tests."""
+    from avatar.blender.scene import Character, Part
+
+    skel = skeleton(rng)
+    body = box_mesh((-0.2, -0.12, 0.0), (0.2, 0.12, 1.7))
+    weights = (np.zeros((8, 1), np.int32), np.ones((8, 1)))
+    head = box_mesh((-0.1, -0.1, 1.72), (0.1, 0.1, 1.95))
+    return Character(name, [Part("body", body, weights), Part("head", head, weights)], skel)

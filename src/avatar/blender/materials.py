@@ -41,7 +41,8 @@ def plain(name: str, colour: Sequence[float], roughness: float = 0.6) -> bpy.typ
 
 def _principled(name: str) -> tuple[bpy.types.Material, bpy.types.Node]:
     mat = bpy.data.materials.new(name)
-    mat.use_nodes = True  # a no-op (and deprecated) from Blender 5.0, needed before
+    if bpy.app.version < (5, 0):  # always node-based from 5.0 (use_nodes deprecated)
+        mat.use_nodes = True
     bsdf = mat.node_tree.nodes.get("Principled BSDF")
     if bsdf is None:  # a future default tree without one
         bsdf = mat.node_tree.nodes.new("ShaderNodeBsdfPrincipled")

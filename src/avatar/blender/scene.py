@@ -242,8 +242,9 @@ def _light(name: str, kind: str, energy: float, euler, scene) -> bpy.types.Objec
 def _world(scene: bpy.types.Scene, colour, strength: float) -> None:
     world = scene.world or bpy.data.worlds.new("World")
     scene.world = world
-    world.use_nodes = True
-    background = world.node_tree.nodes.get("Background")
+    if bpy.app.version < (5, 0):  # always node-based from 5.0 (use_nodes deprecated)
+        world.use_nodes = True
+    background = world.node_tree.nodes.get("Background") if world.node_tree else None
     if background is not None:
         background.inputs["Color"].default_value = (*colour, 1.0)
         background.inputs["Strength"].default_value = strength
