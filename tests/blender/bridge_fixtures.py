@@ -80,10 +80,13 @@ def box_mesh(lo, hi) -> Mesh:
 
 def figure(rng: np.random.Generator, name: str = "figure"):
     """A skinned box on a random skeleton: a minimal Character for render tests."""
-    from avatar.blender.scene import Character, Part
+    from avatar.blender.scene import Character
+    from avatar.part import MeshPart as Part
 
     skel = skeleton(rng)
     body = box_mesh((-0.2, -0.12, 0.0), (0.2, 0.12, 1.7))
     weights = (np.zeros((8, 1), np.int32), np.ones((8, 1)))
     head = box_mesh((-0.1, -0.1, 1.72), (0.1, 0.1, 1.95))
-    return Character(name, [Part("body", body, weights), Part("head", head, weights)], skel)
+    return Character(
+        name, [Part("body", body, skin=weights), Part("head", head, skin=weights)], skel
+    )

@@ -2,33 +2,25 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pytest
 from bridge_fixtures import figure
 
 
-@dataclass(frozen=True)
-class FakeMaterial:
-    """The fields of avatar.material.Material the bridge reads."""
-
-    name: str
-    base_color: tuple = (0.8, 0.5, 0.4)
-    roughness: float = 0.45
-    base_color_texture: np.ndarray | None = None
-    normal_texture: np.ndarray | None = None
-    roughness_texture: np.ndarray | None = None
-
-
 def test_material_node_tree_and_texture_pixels(empty_scene, rng):
     from avatar.blender import materials
+    from avatar.material import Material
 
     colour = rng.integers(0, 256, size=(8, 4, 3), dtype=np.uint8)
     normal = np.full((4, 4, 3), 128, np.uint8)
-    rough = rng.random((4, 4)).astype(np.float32)
-    record = FakeMaterial(
-        "skin", base_color_texture=colour, normal_texture=normal, roughness_texture=rough
+    rough = rng.integers(0, 256, size=(4, 4), dtype=np.uint8)
+    record = Material(
+        "skin",
+        base_color=(1.0, 1.0, 1.0, 1.0),  # white: the texture feeds the BSDF directly
+        base_color_texture=colour,
+        normal_texture=normal,
+        roughness_texture=rough,
+        extras={"subsurface": 0.2},
     )
     mat = materials.material(record)
     nodes = mat.node_tree.nodes
@@ -36,6 +28,7 @@ def test_material_node_tree_and_texture_pixels(empty_scene, rng):
     assert bsdf.inputs["Base Color"].links[0].from_node.image.name == "skin colour"
     assert bsdf.inputs["Normal"].links[0].from_node.type == "NORMAL_MAP"
     assert bsdf.inputs["Roughness"].is_linked
+    assert bsdf.inputs["Subsurface Weight"].default_value == pytest.approx(0.2)
     image = bsdf.inputs["Base Color"].links[0].from_node.image
     assert tuple(image.size) == (4, 8)
     pixels = np.empty(8 * 4 * 4, np.float32)
@@ -43,18 +36,34 @@ def test_material_node_tree_and_texture_pixels(empty_scene, rng):
     top_row_first = pixels.reshape(8, 4, 4)[::-1, :, :3]
     np.testing.assert_allclose(top_row_first, colour / 255.0, atol=1 / 255)
     assert image.packed_file is not None
-    roughness_image = bsdf.inputs["Roughness"].links[0].from_node.image
-    assert roughness_image.colorspace_settings.name == "Non-Color"
+    multiply = bsdf.inputs["Roughness"].links[0].from_node  # texture x roughness factor 0.5
+    assert multiply.inputs[1].default_value == pytest.approx(0.5)
+    assert multiply.inputs[0].links[0].from_node.image.colorspace_settings.name == "Non-Color"
 
 
 def test_scalar_material_and_none(empty_scene):
     from avatar.blender import materials
+    from avatar.material import Material
 
-    mat = materials.material(FakeMaterial("cloth"))
+    mat = materials.material(Material("cloth", base_color=(0.8, 0.5, 0.4, 1.0), roughness=0.45))
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     assert bsdf.inputs["Roughness"].default_value == pytest.approx(0.45)
     assert tuple(bsdf.inputs["Base Color"].default_value)[:3] == pytest.approx((0.8, 0.5, 0.4))
     assert materials.material(None, "grey").name == "grey"
+
+
+def test_masked_alpha_and_tint(empty_scene):
+    from avatar.blender import materials
+    from avatar.material import Material
+
+    cards = np.zeros((4, 4, 4), np.uint8)
+    record = Material("hair", base_color=(0.5, 0.4, 0.3, 1.0), base_color_texture=cards,
+                      alpha_mode="MASK", double_sided=True)  # fmt: skip
+    mat = materials.material(record)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    assert bsdf.inputs["Alpha"].links[0].from_node.operation == "GREATER_THAN"
+    assert bsdf.inputs["Base Color"].links[0].from_node.blend_type == "MULTIPLY"
+    assert not mat.use_backface_culling
 
 
 @pytest.mark.parametrize("suffix", [".fbx", ".usdc", ".blend"])

@@ -28,6 +28,23 @@ def test_character_from_human_like_object(empty_scene, rng):
     assert [g.name for g in body.vertex_groups] == list(skel.names)
 
 
+def test_parts_with_normals_and_morphs(empty_scene, rng):
+    from avatar.blender import scene
+    from avatar.part import MeshPart
+
+    box = box_mesh((0, 0, 0), (1, 1, 1))
+    normals = np.tile(np.array([[0.0, 0.0, 1.0]], np.float32), (8, 1))
+    part = MeshPart("lid", box, morphs={"open": np.ones((8, 3), np.float32) * 0.1},
+                    normals=normals)  # fmt: skip
+    built = scene.build_character(scene.Character("box", [part]))
+    obj = built.root
+    assert obj is built.parts[0] and built.armature is None
+    assert obj.data.shape_keys.key_blocks.keys() == ["Basis", "open"]
+    corner = np.array([n.vector[:] for n in obj.data.corner_normals])
+    # Blender stores custom normals compressed (about 1e-4 rad resolution).
+    np.testing.assert_allclose(corner, np.tile([0, 0, 1], (len(corner), 1)), atol=2e-4)
+
+
 def test_camera_sees_every_character(empty_scene, rng):
     import bpy
     from bpy_extras.object_utils import world_to_camera_view

@@ -1,12 +1,9 @@
-"""Material record -> Principled BSDF node tree, with image textures made from numpy arrays.
+"""``avatar.material.Material`` -> Principled BSDF node tree with images from numpy arrays.
 
-The record is ``avatar.material.Material``; fields are read by name with ``getattr`` so this
-module needs nothing else from it. Fields used (all optional): ``name``, ``base_color``
-(3 or 4 floats, linear), ``roughness``, ``metallic``, ``alpha``, ``subsurface``,
-``subsurface_radius`` (3 floats, metres), ``base_color_texture`` (H, W, 3|4),
-``normal_texture`` (H, W, 3, tangent space, OpenGL +Y), ``roughness_texture`` (H, W) or
-(H, W, 3|4) glTF metallic-roughness (G = roughness, B = metallic), ``normal_strength``.
-Textures are uint8 0..255 or float 0..1, row 0 at the top (as PNG and glTF store them).
+Mirrors glTF's metallic-roughness model, as the record does: the colour texture is multiplied
+by ``base_color``, the roughness texture by ``roughness``; ``alpha_mode`` MASK thresholds
+alpha at ``alpha_cutoff``. Renderer hints in ``extras`` (``subsurface``,
+``subsurface_radius``, ``sheen``, ``coat``) go to the matching BSDF inputs.
 """
 
 from __future__ import annotations
@@ -17,16 +14,34 @@ import bpy
 import numpy as np
 
 _GREY = (0.55, 0.55, 0.55)
+_EXTRAS = {  # Material.extras key -> Principled BSDF input (Blender 4.0+ names)
+    "subsurface": "Subsurface Weight",
+    "subsurface_radius": "Subsurface Radius",
+    "subsurface_scale": "Subsurface Scale",
+    "sheen": "Sheen Weight",
+    "coat": "Coat Weight",
+    "specular": "Specular IOR Level",
+}
 
 
 def material(record: object | None, fallback_name: str = "Material") -> bpy.types.Material:
-    """A new node material from a Material record (or a plain grey one for None)."""
+    """A new node material from a Material record (a plain grey one for None)."""
     if record is None:
         return plain(fallback_name, _GREY)
-    name = getattr(record, "name", None) or fallback_name
-    mat, bsdf = _principled(name)
-    _set_scalars(bsdf, record)
-    _link_textures(mat, bsdf, record, name)
+    mat, bsdf = _principled(record.name or fallback_name)
+    rgba = tuple(float(c) for c in record.base_color)
+    bsdf.inputs["Base Color"].default_value = rgba
+    bsdf.inputs["Alpha"].default_value = rgba[3]
+    bsdf.inputs["Roughness"].default_value = float(record.roughness)
+    bsdf.inputs["Metallic"].default_value = float(record.metallic)
+    mat.diffuse_color = rgba  # what Workbench and the viewport's solid mode show
+    mat.use_backface_culling = not record.double_sided
+    _set_extras(bsdf, record.extras)
+    _link_colour(mat, bsdf, record)
+    _link_roughness(mat.node_tree, bsdf, record)
+    _link_normal(mat.node_tree, bsdf, record)
+    if record.alpha_mode == "BLEND" and hasattr(mat, "surface_render_method"):
+        mat.surface_render_method = "BLENDED"  # EEVEE; Cycles blends regardless
     return mat
 
 
@@ -35,7 +50,7 @@ def plain(name: str, colour: Sequence[float], roughness: float = 0.6) -> bpy.typ
     mat, bsdf = _principled(name)
     bsdf.inputs["Base Color"].default_value = (*colour[:3], 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
-    mat.diffuse_color = (*colour[:3], 1.0)  # Workbench's material colour
+    mat.diffuse_color = (*colour[:3], 1.0)
     return mat
 
 
@@ -43,83 +58,99 @@ def _principled(name: str) -> tuple[bpy.types.Material, bpy.types.Node]:
     mat = bpy.data.materials.new(name)
     if bpy.app.version < (5, 0):  # always node-based from 5.0 (use_nodes deprecated)
         mat.use_nodes = True
-    bsdf = mat.node_tree.nodes.get("Principled BSDF")
-    if bsdf is None:  # a future default tree without one
-        bsdf = mat.node_tree.nodes.new("ShaderNodeBsdfPrincipled")
-        output = mat.node_tree.nodes.get("Material Output") or mat.node_tree.nodes.new(
-            "ShaderNodeOutputMaterial"
-        )
+    nodes = mat.node_tree.nodes
+    bsdf = nodes.get("Principled BSDF")
+    if bsdf is None:  # a default tree without one
+        bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+        output = nodes.get("Material Output") or nodes.new("ShaderNodeOutputMaterial")
         mat.node_tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
     return mat, bsdf
 
 
-def _set_scalars(bsdf: bpy.types.Node, record: object) -> None:
-    colour = getattr(record, "base_color", None)
-    if colour is not None:
-        rgba = (*[float(c) for c in colour][:3], 1.0)
-        bsdf.inputs["Base Color"].default_value = rgba
-    for field, socket in (("roughness", "Roughness"), ("metallic", "Metallic"),
-                          ("alpha", "Alpha"), ("subsurface", "Subsurface Weight")):  # fmt: skip
-        value = getattr(record, field, None)
-        if value is not None and socket in bsdf.inputs:
-            bsdf.inputs[socket].default_value = float(value)
-    radius = getattr(record, "subsurface_radius", None)
-    if radius is not None and "Subsurface Radius" in bsdf.inputs:
-        bsdf.inputs["Subsurface Radius"].default_value = [float(r) for r in radius][:3]
+def _set_extras(bsdf: bpy.types.Node, extras: dict) -> None:
+    for key, socket in _EXTRAS.items():
+        if key in extras and socket in bsdf.inputs:
+            value = extras[key]
+            target = bsdf.inputs[socket]
+            target.default_value = value if np.ndim(value) == 0 else list(value)[:3]
 
 
-def _link_textures(mat: bpy.types.Material, bsdf: bpy.types.Node, record, name: str) -> None:
+def _link_colour(mat: bpy.types.Material, bsdf: bpy.types.Node, record) -> None:
+    image = record.base_color_texture
+    if image is None:
+        return
     tree = mat.node_tree
-    colour = getattr(record, "base_color_texture", None)
-    if colour is not None:
-        node = _image_node(tree, image_from_array(f"{name} colour", colour), (-500, 300))
-        tree.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
-        if np.shape(colour)[-1] == 4 and np.ndim(colour) == 3:
-            tree.links.new(node.outputs["Alpha"], bsdf.inputs["Alpha"])
-    else:
-        base = getattr(record, "base_color", None) or _GREY
-        mat.diffuse_color = (*[float(c) for c in base][:3], 1.0)
-    rough = getattr(record, "roughness_texture", None)
-    if rough is not None:
-        _link_roughness(tree, bsdf, rough, name)
-    normal = getattr(record, "normal_texture", None)
-    if normal is not None:
-        _link_normal(tree, bsdf, normal, name, getattr(record, "normal_strength", None))
+    node = _image_node(tree, image_from_array(f"{record.name} colour", image), (-700, 300))
+    colour_out = _multiply_colour(tree, node.outputs["Color"], record.base_color)
+    tree.links.new(colour_out, bsdf.inputs["Base Color"])
+    mat.diffuse_color = (*_mean_colour(image), 1.0)
+    if image.ndim == 3 and image.shape[2] == 4:
+        alpha = node.outputs["Alpha"]
+        if record.alpha_mode == "MASK":
+            alpha = _math(tree, "GREATER_THAN", alpha, record.alpha_cutoff, (-300, 100))
+        if record.alpha_mode != "OPAQUE":
+            tree.links.new(alpha, bsdf.inputs["Alpha"])
 
 
-def _link_roughness(tree, bsdf, rough: np.ndarray, name: str) -> None:
-    image = image_from_array(f"{name} roughness", rough, non_color=True)
-    node = _image_node(tree, image, (-500, 0))
-    if np.ndim(rough) == 3 and np.shape(rough)[-1] >= 3:
-        split = tree.nodes.new("ShaderNodeSeparateColor")
-        split.location = (-220, 0)
-        tree.links.new(node.outputs["Color"], split.inputs["Color"])
-        tree.links.new(split.outputs["Green"], bsdf.inputs["Roughness"])
-        tree.links.new(split.outputs["Blue"], bsdf.inputs["Metallic"])
-    else:
-        tree.links.new(node.outputs["Color"], bsdf.inputs["Roughness"])
+def _multiply_colour(tree, colour_socket, factor) -> bpy.types.NodeSocket:
+    """colour * factor.rgb through a Mix node, skipped when the factor is white."""
+    if all(abs(float(c) - 1.0) < 1e-6 for c in factor[:3]):
+        return colour_socket
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type, mix.blend_type, mix.location = "RGBA", "MULTIPLY", (-350, 300)
+    mix.inputs["Factor"].default_value = 1.0
+    tree.links.new(colour_socket, mix.inputs["A"])
+    mix.inputs["B"].default_value = (*[float(c) for c in factor[:3]], 1.0)
+    return mix.outputs["Result"]
 
 
-def _link_normal(tree, bsdf, normal: np.ndarray, name: str, strength) -> None:
-    image = image_from_array(f"{name} normal", normal, non_color=True)
-    node = _image_node(tree, image, (-500, -300))
+def _mean_colour(image: np.ndarray) -> tuple[float, float, float]:
+    """Linear mean colour of an sRGB uint8 image (for the viewport's solid colour)."""
+    srgb = np.asarray(image[..., :3], np.float32).reshape(-1, 3).mean(axis=0) / 255.0
+    return tuple(float(c) for c in np.where(srgb <= 0.04045, srgb / 12.92,
+                                            ((srgb + 0.055) / 1.055) ** 2.4))  # fmt: skip
+
+
+def _link_roughness(tree, bsdf: bpy.types.Node, record) -> None:
+    image = record.roughness_texture
+    if image is None:
+        return
+    node = _image_node(tree, image_from_array(f"{record.name} roughness", image, True),
+                       (-700, 0))  # fmt: skip
+    value = node.outputs["Color"]
+    if abs(record.roughness - 1.0) > 1e-6:
+        value = _math(tree, "MULTIPLY", value, record.roughness, (-300, 0))
+    tree.links.new(value, bsdf.inputs["Roughness"])
+
+
+def _link_normal(tree, bsdf: bpy.types.Node, record) -> None:
+    image = record.normal_texture
+    if image is None:
+        return
+    node = _image_node(tree, image_from_array(f"{record.name} normal", image, True), (-700, -300))
     normal_map = tree.nodes.new("ShaderNodeNormalMap")
-    normal_map.location = (-220, -300)
-    if strength is not None:
-        normal_map.inputs["Strength"].default_value = float(strength)
+    normal_map.location = (-300, -300)
+    normal_map.inputs["Strength"].default_value = float(record.normal_scale)
     tree.links.new(node.outputs["Color"], normal_map.inputs["Color"])
     tree.links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
 
 
+def _math(tree, operation: str, socket, value: float, location) -> bpy.types.NodeSocket:
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation, node.location = operation, location
+    tree.links.new(socket, node.inputs[0])
+    node.inputs[1].default_value = float(value)
+    return node.outputs["Value"]
+
+
 def _image_node(tree, image: bpy.types.Image, location) -> bpy.types.Node:
     node = tree.nodes.new("ShaderNodeTexImage")
-    node.image = image
-    node.location = location
+    node.image, node.location = image, location
     return node
 
 
 def image_from_array(name: str, array: np.ndarray, non_color: bool = False) -> bpy.types.Image:
-    """A packed Blender image from (H, W), (H, W, 1|3|4) uint8 or float 0..1, row 0 on top.
+    """A packed Blender image from (H, W) or (H, W, 1|2|3|4) uint8 or float 0..1, row 0 on top.
 
     non_color: data textures (normal, roughness) that must not be colour-managed.
     The image is packed into the .blend so saving or exporting keeps it.
@@ -127,8 +158,7 @@ def image_from_array(name: str, array: np.ndarray, non_color: bool = False) -> b
     rgba = to_rgba(array)
     height, width = rgba.shape[:2]
     image = bpy.data.images.new(name, width, height, alpha=True)
-    # Blender stores rows bottom-up.
-    image.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).ravel())
+    image.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).ravel())  # Blender: bottom-up
     if non_color:
         image.colorspace_settings.name = "Non-Color"
     image.pack()
@@ -141,10 +171,7 @@ def to_rgba(array: np.ndarray) -> np.ndarray:
     a = a.astype(np.float32) / 255.0 if a.dtype == np.uint8 else a.astype(np.float32)
     if a.ndim == 2:
         a = a[..., None]
-    channels = a.shape[-1]
-    if channels == 1:
-        a = np.repeat(a, 3, axis=-1)
-    if channels == 2:  # grey + alpha
+    if a.shape[-1] in (1, 2):  # grey (+ alpha)
         a = np.concatenate([np.repeat(a[..., :1], 3, axis=-1), a[..., 1:]], axis=-1)
     if a.shape[-1] == 3:
         a = np.concatenate([a, np.ones(a.shape[:2] + (1,), np.float32)], axis=-1)

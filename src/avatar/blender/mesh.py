@@ -94,6 +94,11 @@ def set_shape_keys(obj: bpy.types.Object, offsets: Mapping[str, np.ndarray]) -> 
         key.value = 0.0
 
 
+def set_normals(obj: bpy.types.Object, normals: np.ndarray) -> None:
+    """Custom per-vertex normals (V, 3) (e.g. the body's, so seams between parts match)."""
+    obj.data.normals_split_custom_set_from_vertices(np.asarray(normals, np.float32))
+
+
 def read_vertices(obj: bpy.types.Object, evaluated: bool = False) -> np.ndarray:
     """(V, 3) float32 vertex positions in object space; ``evaluated`` applies modifiers/keys."""
     if evaluated:

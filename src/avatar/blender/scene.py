@@ -1,14 +1,15 @@
 """Whole characters and their stage: body, garments, armature, action, camera, lights, floor.
 
-Input is plain records (``Character``, ``Part``) of arrays, so the bridge does not depend on
-how the core assembles a human; ``character_from_human`` adapts an ``avatar.human.Human``.
+Input is plain records of arrays (a ``Character`` of ``avatar.part.MeshPart``), so the bridge
+does not depend on how the core assembles a human; ``character_from_human`` adapts an
+``avatar.human.Human``.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import bpy
 import numpy as np
@@ -19,30 +20,15 @@ from avatar.blender import armature as armature_bridge
 from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
 from avatar.mesh import Mesh
+from avatar.part import MeshPart
 from avatar.rig.skeleton import Animation, Skeleton
-
-Weights = tuple[np.ndarray, np.ndarray]  # (V, K) joint indices, (V, K) weights
-
-
-@dataclass(frozen=True)
-class Part:
-    """One skinned surface of a character (the body, or a garment).
-
-    mesh: the rest-pose Mesh. weights: (indices (V, K), weights (V, K)) into the skeleton's
-    bones, or None. material: an ``avatar.material.Material``-like record, or None (grey).
-    shape_keys: name -> (V, 3) offsets from the rest vertices (metres).
-    """
-
-    name: str
-    mesh: Mesh
-    weights: Weights | None = None
-    material: object | None = None
-    shape_keys: Mapping[str, np.ndarray] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class Character:
     """Everything needed to stage one character: parts skinned to one optional skeleton.
+
+    parts: MeshParts (body first); their ``skin`` indexes ``skeleton.names``.
 
     location: (3,) where the armature (or, without one, every part) is placed, metres.
     recipe: JSON-able dict stored on the root object (``avatar_recipe``) so the extension can
@@ -50,7 +36,7 @@ class Character:
     """
 
     name: str
-    parts: Sequence[Part]
+    parts: Sequence[MeshPart]
     skeleton: Skeleton | None = None
     animation: Animation | None = None
     location: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -90,35 +76,39 @@ def build_character(
 
 
 def _build_part(
-    part: Part,
+    part: MeshPart,
     skeleton: Skeleton | None,
     armature: bpy.types.Object | None,
     collection: bpy.types.Collection,
 ) -> bpy.types.Object:
     obj = mesh_bridge.new_mesh_object(part.name, part.mesh, collection)
     obj.data.materials.append(material_bridge.material(part.material, part.name))
-    if skeleton is not None and part.weights is not None:
-        mesh_bridge.set_vertex_groups(obj, skeleton.names, *part.weights)
+    if part.normals is not None:
+        mesh_bridge.set_normals(obj, part.normals)
+    if skeleton is not None and part.skin is not None:
+        mesh_bridge.set_vertex_groups(obj, skeleton.names, *part.skin)
     if armature is not None:
         armature_bridge.bind(obj, armature)
-    mesh_bridge.set_shape_keys(obj, part.shape_keys)
+    mesh_bridge.set_shape_keys(obj, part.morphs)
     return obj
 
 
 def character_from_human(human: object, name: str = "Avatar", **kwargs: object) -> Character:
-    """Adapt an ``avatar.human.Human``-like object (``.mesh``, ``.skeleton``, ``.weights``).
+    """Adapt an ``avatar.human.Human``-like object to a Character.
 
-    Optional attributes used when present: ``material`` (body), ``garments`` (records with
-    ``name``, ``mesh``, ``weights``, ``material``), ``animation``, ``to_recipe()``.
+    Uses ``human.parts()`` (MeshParts: body, eyes, garments) when it has it, else
+    ``human.mesh``, ``human.weights`` and ``human.material`` as one body part; plus
+    ``human.skeleton``, ``human.animation`` and ``human.to_recipe()`` when present.
     kwargs override Character fields (e.g. ``location``, ``animation``).
     """
-    parts = [Part("body", human.mesh, getattr(human, "weights", None),
-                  getattr(human, "material", None))]  # fmt: skip
-    for g in getattr(human, "garments", None) or ():
-        parts.append(Part(g.name, g.mesh, getattr(g, "weights", None),
-                          getattr(g, "material", None)))  # fmt: skip
+    parts = getattr(human, "parts", None)
+    if callable(parts):
+        parts = parts()
+    if parts is None:
+        parts = [MeshPart("body", human.mesh, getattr(human, "material", None),
+                          getattr(human, "weights", None))]  # fmt: skip
     recipe = human.to_recipe() if hasattr(human, "to_recipe") else None
-    fields = dict(name=name, parts=parts, skeleton=getattr(human, "skeleton", None),
+    fields = dict(name=name, parts=list(parts), skeleton=getattr(human, "skeleton", None),
                   animation=getattr(human, "animation", None), recipe=recipe)  # fmt: skip
     fields.update(kwargs)
     return Character(**fields)
