@@ -1,0 +1,154 @@
+"""The composition root: a serialisable recipe and the human it realises.
+
+    human = Human({"gender": 1.0, "age": 0.4, "pca/belly": 1.5}, rig="game_engine")
+    human.mesh, human.skeleton, human.weights, human.posed(animation)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from avatar.assets import RIG_NAMES
+from avatar.body.model import BodyModel
+from avatar.errors import ParameterError, unknown_name
+from avatar.mesh import Mesh
+from avatar.rig import kinematics, poses, skinning
+from avatar.rig.placement import RigDefinition
+from avatar.rig.skeleton import Animation, Skeleton
+from avatar.rig.skinning import SkinWeights
+
+RECIPE_VERSION = 1
+BODY_PART_GROUPS = {"body": ("body",), "eyes": ("helper-l-eye", "helper-r-eye")}
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """Everything that defines a character; plain data, JSON-serialisable."""
+
+    params: dict[str, float] = field(default_factory=dict)
+    rig: str = "default"
+    pose: str | None = None
+    clothes: tuple[str, ...] = ()
+    motion: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "version": RECIPE_VERSION,
+            "params": dict(self.params),
+            "rig": self.rig,
+            "pose": self.pose,
+            "clothes": list(self.clothes),
+            "motion": self.motion,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Recipe:
+        unknown = set(data) - {"version", "params", "rig", "pose", "clothes", "motion"}
+        if unknown:
+            raise ParameterError(f"unknown recipe fields: {', '.join(sorted(unknown))}")
+        return cls(
+            params={str(k): float(v) for k, v in (data.get("params") or {}).items()},
+            rig=str(data.get("rig", "default")),
+            pose=data.get("pose"),
+            clothes=tuple(data.get("clothes") or ()),
+            motion=data.get("motion"),
+        )
+
+
+class Human:
+    """A shaped, rigged human realised from a recipe. Arrays are computed lazily, once."""
+
+    def __init__(
+        self,
+        params: Mapping[str, float] | None = None,
+        rig: str = "default",
+        model: BodyModel | None = None,
+        recipe: Recipe | None = None,
+    ):
+        if rig not in RIG_NAMES:
+            raise unknown_name("rig", rig, RIG_NAMES)
+        self.model = model or BodyModel.load()
+        values = self.model.resolve(params)  # validates names and ranges up front
+        self.recipe = replace(recipe or Recipe(), params=values, rig=rig)
+
+    @classmethod
+    def from_recipe(cls, recipe: Recipe | Mapping[str, Any], model: BodyModel | None = None) -> Human:
+        r = recipe if isinstance(recipe, Recipe) else Recipe.from_dict(recipe)
+        return cls(r.params, r.rig, model, r)
+
+    def to_recipe(self) -> dict[str, Any]:
+        return self.recipe.to_dict()
+
+    @property
+    def params(self) -> dict[str, float]:
+        return dict(self.recipe.params)
+
+    # ------------------------------------------------------------------ geometry
+    @cached_property
+    def vertices(self) -> np.ndarray:
+        """(19158, 3) float32 all vertices incl. helpers, metres, Z-up, feet on z = 0."""
+        v = self.model.shape(self.recipe.params)
+        ground = v[self.model.base.groups["joint-ground"], 2].mean()
+        return (v - np.array([0.0, 0.0, ground], dtype=np.float32)).astype(np.float32)
+
+    def part(self, name: str) -> Mesh:
+        """A renderable part ("body", "eyes") as its own Mesh (helpers excluded)."""
+        base = self.model.base
+        faces = np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]])
+        return base.with_vertices(self.vertices).subset(np.sort(faces))
+
+    def part_vertices(self, name: str) -> np.ndarray:
+        """Indices into ``vertices`` of a part's vertices, in the part mesh's order."""
+        base = self.model.base
+        faces = np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]])
+        return np.unique(base.faces[faces])
+
+    @property
+    def mesh(self) -> Mesh:
+        """The skin mesh (13,380 vertices), the part most users want."""
+        return self.part("body")
+
+    # ------------------------------------------------------------------ rig
+    @cached_property
+    def rig(self) -> RigDefinition:
+        return RigDefinition.from_json(
+            self.recipe.rig, self.model.assets.rig(self.recipe.rig), self.model.base.groups
+        )
+
+    @cached_property
+    def skeleton(self) -> Skeleton:
+        """The rig placed on this body, in rest pose."""
+        return self.rig.skeleton(self.vertices)
+
+    @cached_property
+    def weights(self) -> SkinWeights:
+        """Skin weights of all 19,158 vertices over ``skeleton``'s bones."""
+        bones, offsets, vertex, weight = self.model.assets.weights(self.recipe.rig)
+        index = {b: i for i, b in enumerate(self.skeleton.names)}
+        counts = np.diff(offsets)
+        bone_ids = np.array([index.get(b, -1) for b in bones])
+        bone_of_entry = np.repeat(bone_ids, counts)
+        keep = bone_of_entry >= 0  # weights of bones this rig lacks (none in shipped rigs)
+        return SkinWeights.from_lists(
+            len(self.vertices), bone_of_entry[keep], vertex[keep], weight[keep]
+        )
+
+    def pose(self, name: str) -> Animation:
+        """A named pose ("rest", "a-pose", "t-pose") for this rig."""
+        return poses.named_pose(self.skeleton, self.recipe.rig, name, self.model.assets.meta["poses"])
+
+    def posed(
+        self, animation: Animation, frames: slice | None = None, method: str = "lbs"
+    ) -> np.ndarray:
+        """(T, 19158, 3) posed vertices for an animation on this skeleton (LBS or DQS)."""
+        rot = animation.rotations[frames or slice(None)]
+        trans = animation.translations[frames or slice(None)]
+        world = kinematics.forward(self.skeleton, rot, trans)
+        mats = kinematics.skinning_matrices(self.skeleton, world)
+        skin = skinning.dual_quaternion if method == "dqs" else skinning.linear_blend
+        return skin(self.vertices, self.weights, mats)

@@ -1,0 +1,114 @@
+"""Skin weights and skinning: linear blend (LBS) and dual quaternion (DQS).
+
+Written as numbered steps in the manner of smplx's ``lbs.py``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar.rig import quaternion
+
+
+@dataclass(frozen=True)
+class SkinWeights:
+    """Per-vertex bone influences, padded to K with weight 0.
+
+    indices: (V, K) int32 bone indices; weights: (V, K) float32, each row summing to 1.
+    """
+
+    indices: np.ndarray
+    weights: np.ndarray
+
+    @classmethod
+    def from_lists(
+        cls,
+        vertex_count: int,
+        bone_of_entry: np.ndarray,
+        vertex: np.ndarray,
+        weight: np.ndarray,
+        fallback_bone: int = 0,
+    ) -> SkinWeights:
+        """Build from flat (bone, vertex, weight) triples; unweighted vertices follow
+        ``fallback_bone``; rows are normalised to sum 1."""
+        keep = weight > 0
+        bone_of_entry, vertex, weight = bone_of_entry[keep], vertex[keep], weight[keep]
+        order = np.lexsort((-weight, vertex))
+        bone_of_entry, vertex, weight = bone_of_entry[order], vertex[order], weight[order]
+        counts = np.bincount(vertex, minlength=vertex_count)
+        k = max(int(counts.max(initial=1)), 1)
+        slot = np.arange(len(vertex)) - np.repeat(np.cumsum(counts) - counts, counts)
+        idx = np.zeros((vertex_count, k), dtype=np.int32)
+        w = np.zeros((vertex_count, k), dtype=np.float64)
+        idx[vertex, slot] = bone_of_entry
+        w[vertex, slot] = weight
+        empty = counts == 0
+        idx[empty, 0], w[empty, 0] = fallback_bone, 1.0
+        w /= w.sum(axis=1, keepdims=True)
+        return cls(idx, w.astype(np.float32))
+
+    def limit(self, k: int) -> SkinWeights:
+        """Keep the ``k`` largest influences per vertex, renormalised (for game engines)."""
+        if self.weights.shape[1] <= k:
+            return self
+        order = np.argsort(-self.weights, axis=1)[:, :k]
+        w = np.take_along_axis(self.weights, order, 1).astype(np.float64)
+        w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-12)
+        return SkinWeights(np.take_along_axis(self.indices, order, 1), w.astype(np.float32))
+
+    def subset(self, vertex_index: np.ndarray) -> SkinWeights:
+        """Weights of the given vertices only."""
+        return SkinWeights(self.indices[vertex_index], self.weights[vertex_index])
+
+    def dense(self, bones: int) -> np.ndarray:
+        """(V, J) dense weight matrix."""
+        out = np.zeros((len(self.indices), bones), dtype=np.float32)
+        np.add.at(out, (np.arange(len(self.indices))[:, None], self.indices), self.weights)
+        return out
+
+
+def linear_blend(vertices: np.ndarray, weights: SkinWeights, matrices: np.ndarray) -> np.ndarray:
+    """Linear blend skinning.
+
+    vertices: (V, 3) rest positions; matrices: (..., J, 4, 4) skinning matrices
+    (world @ inverse rest). Returns (..., V, 3) float32 posed positions.
+    """
+    # 1. Blend the 3x4 matrices per vertex: sum_k w_k M_{b_k}  -> (..., V, 3, 4)
+    m = matrices[..., :3, :]
+    blended = np.einsum("vk,...vkij->...vij", weights.weights, m[..., weights.indices, :, :])
+    # 2. Apply to homogeneous rest positions.
+    out = np.einsum("...vij,vj->...vi", blended[..., :3], vertices) + blended[..., 3]
+    return out.astype(np.float32)
+
+
+def dual_quaternions(matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rigid (..., J, 4, 4) -> real (..., J, 4) and dual (..., J, 4) quaternion parts."""
+    real = quaternion.from_matrix(matrices[..., :3, :3])
+    t = np.concatenate([np.zeros(matrices.shape[:-2] + (1,)), matrices[..., :3, 3]], axis=-1)
+    dual = 0.5 * quaternion.multiply(t, real)
+    return real, dual
+
+
+def dual_quaternion(vertices: np.ndarray, weights: SkinWeights, matrices: np.ndarray) -> np.ndarray:
+    """Dual quaternion skinning (Kavan et al. 2007); same arguments as ``linear_blend``.
+
+    Avoids LBS's candy-wrapper collapse under twists. Matrices must be rigid.
+    """
+    real, dual = dual_quaternions(matrices)
+    # 1. Gather each vertex's bone quaternions, flipped into the hemisphere of the first.
+    r = real[..., weights.indices, :]  # (..., V, K, 4)
+    d = dual[..., weights.indices, :]
+    sign = np.where(np.sum(r * r[..., :1, :], axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    w = weights.weights[..., None] * sign
+    # 2. Blend and normalise.
+    br = np.sum(w * r, axis=-2)
+    bd = np.sum(w * d, axis=-2)
+    norm = np.linalg.norm(br, axis=-1, keepdims=True)
+    br, bd = br / norm, bd / norm
+    # 3. Rotate then translate: t = 2 * dual * conj(real).
+    rot = quaternion.to_matrix(br)
+    trans = 2.0 * quaternion.multiply(bd, quaternion.conjugate(br))[..., 1:]
+    out = np.einsum("...vij,vj->...vi", rot, vertices) + trans
+    return out.astype(np.float32)
