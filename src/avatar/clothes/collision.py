@@ -1,0 +1,192 @@
+"""Signed distance of points to the closed body surface, and push-out with a clearance.
+
+The body (hm08's 13,380 body vertices, 13,378 quads) is watertight, so "inside" is well
+defined. A point's signed distance is measured to its closest point on the body's triangles,
+with the sign and push direction taken from the vertex normals interpolated at that point
+(for a closest point on an edge or corner this matches the angle-weighted pseudo-normal's
+sign on every convex or concave feature, and gives a smooth push direction).
+
+Speed: candidate triangles are the one-rings of the k nearest body vertices found with a
+scipy cKDTree, then all candidates are tested at once with array maths (Ericson's
+closest-point-on-triangle regions).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.spatial import cKDTree
+
+
+@dataclass(frozen=True)
+class BodySurface:
+    """Topology of a closed body surface (independent of its pose or shape).
+
+    faces: (F, 3|4) int32 polygon faces (for vertex normals).
+    triangles: (T, 3) int32 triangles (quads split on their 0-2 diagonal).
+    rings: (V, R) int32 triangles around each vertex, padded by repeating the first.
+    incidence: (V, T) sparse vertex-triangle incidence (sums triangle normals per vertex).
+    """
+
+    faces: np.ndarray
+    triangles: np.ndarray
+    rings: np.ndarray
+    incidence: csr_matrix
+
+    def normals(self, vertices: np.ndarray) -> np.ndarray:
+        """(V, 3) float32 unit area-weighted vertex normals of the body posed at vertices."""
+        x = np.asarray(vertices, dtype=np.float32)
+        t = self.triangles
+        fn = np.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]])
+        n = self.incidence @ fn
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+        return n.astype(np.float32)
+
+
+def body_surface(faces: np.ndarray) -> BodySurface:
+    """Precompute the triangle one-rings of a body's faces (F, 3|4) int32."""
+    faces = np.asarray(faces, dtype=np.int32)
+    tris = faces if faces.shape[1] == 3 else np.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]])
+    tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])]
+    vert = tris.ravel()
+    tri = np.repeat(np.arange(len(tris), dtype=np.int32), 3)
+    order = np.argsort(vert, kind="stable")
+    vert, tri = vert[order], tri[order]
+    count = np.bincount(vert, minlength=int(faces.max()) + 1)
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    width = int(count.max())
+    slot = np.arange(len(vert)) - start[vert]
+    rings = np.full((len(count), width), -1, np.int32)
+    rings[vert, slot] = tri
+    first = np.where(rings[:, :1] >= 0, rings[:, :1], 0)
+    rings = np.where(rings >= 0, rings, first)
+    incidence = csr_matrix(
+        (np.ones(len(vert), np.float32), (vert, tri)), shape=(len(count), len(tris))
+    )
+    return BodySurface(faces, tris.astype(np.int32), rings, incidence)
+
+
+@dataclass(frozen=True)
+class SurfaceQuery:
+    """Closest body points for N query points.
+
+    distance: (N,) float32 signed distance (m), negative inside the body.
+    closest: (N, 3) float32 closest points on the surface.
+    normal: (N, 3) float32 unit outward normals there.
+    vertex: (N,) int32 the nearest body vertex (for per-vertex bookkeeping like layers).
+    """
+
+    distance: np.ndarray
+    closest: np.ndarray
+    normal: np.ndarray
+    vertex: np.ndarray
+
+
+def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(..., 3) barycentric weights of the closest point to p on triangles abc (all (..., 3))."""
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = _dot(ab, ap), _dot(ac, ap)
+    bp = p - b
+    d3, d4 = _dot(ab, bp), _dot(ac, bp)
+    cp = p - c
+    d5, d6 = _dot(ab, cp), _dot(ac, cp)
+    va = d3 * d6 - d5 * d4
+    vb = d5 * d2 - d1 * d6
+    vc = d1 * d4 - d3 * d2
+    # Interior by default, then overwrite with the edge and vertex regions (Ericson 5.1.5).
+    denom = va + vb + vc
+    denom = np.where(np.abs(denom) > 1e-30, denom, 1e-30)
+    v, w = vb / denom, vc / denom
+    u = 1.0 - v - w
+    bary = np.stack([u, v, w], axis=-1)
+    bary = _edge(bary, (vc <= 0) & (d1 >= 0) & (d3 <= 0), d1, d1 - d3, 0, 1)
+    bary = _edge(bary, (vb <= 0) & (d2 >= 0) & (d6 <= 0), d2, d2 - d6, 0, 2)
+    bary = _edge(bary, (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), d4 - d3, (d4 - d3) + (d5 - d6), 1, 2)
+    bary = _corner(bary, (d1 <= 0) & (d2 <= 0), 0)
+    bary = _corner(bary, (d3 >= 0) & (d4 <= d3), 1)
+    bary = _corner(bary, (d6 >= 0) & (d5 <= d6), 2)
+    return bary
+
+
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", x, y)
+
+
+def _edge(bary, mask, num, den, i, j):
+    t = np.clip(num / np.where(np.abs(den) > 1e-30, den, 1e-30), 0.0, 1.0)
+    edge = np.zeros_like(bary)
+    edge[..., i] = 1.0 - t
+    edge[..., j] = t
+    return np.where(mask[..., None], edge, bary)
+
+
+def _corner(bary, mask, i):
+    corner = np.zeros_like(bary)
+    corner[..., i] = 1.0
+    return np.where(mask[..., None], corner, bary)
+
+
+def query(
+    body_vertices: np.ndarray,
+    surface: BodySurface,
+    points: np.ndarray,
+    k: int = 3,
+    tree: cKDTree | None = None,
+    normals: np.ndarray | None = None,
+) -> SurfaceQuery:
+    """Signed distances of points (N, 3) to the body (V, 3) (see SurfaceQuery).
+
+    k: nearest body vertices whose triangle rings are tested (more = exact further away).
+    tree, normals: reuse a cKDTree / (V, 3) vertex normals already built for this pose.
+    """
+    x = np.asarray(body_vertices, dtype=np.float32)
+    p = np.asarray(points, dtype=np.float32)
+    if tree is None:
+        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
+    if normals is None:
+        normals = surface.normals(x)
+    _, near = tree.query(p, k=k, workers=-1)
+    near = near.reshape(len(p), k)
+    cand = surface.rings[near].reshape(len(p), -1)  # (N, C)
+    tri = surface.triangles[cand]  # (N, C, 3)
+    corners = x[tri]  # (N, C, 3, 3)
+    pc = p[:, None, :]
+    bary = closest_on_triangles(pc, corners[..., 0, :], corners[..., 1, :], corners[..., 2, :])
+    close = np.einsum("ncj,ncjd->ncd", bary, corners)
+    best = np.argmin(np.einsum("ncd,ncd->nc", pc - close, pc - close), axis=1)
+    rows = np.arange(len(p))
+    bary, tri_best, close = bary[rows, best], tri[rows, best], close[rows, best]
+    n = np.einsum("nj,njd->nd", bary, normals[tri_best])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    gap = p - close
+    sign = np.where(_dot(gap, n) < 0, -1.0, 1.0)
+    return SurfaceQuery(
+        distance=(sign * np.linalg.norm(gap, axis=1)).astype(np.float32),
+        closest=close.astype(np.float32),
+        normal=n.astype(np.float32),
+        vertex=near[:, 0].astype(np.int32),
+    )
+
+
+def penetration(
+    body_vertices: np.ndarray, body_faces: np.ndarray, points: np.ndarray, tolerance: float = 0.0
+) -> tuple[int, np.ndarray]:
+    """How many points lie inside the body, and how deep.
+
+    body_vertices: (V, 3) closed body surface positions (m); body_faces: (F, 3|4) int32.
+    points: (N, 3) garment vertices. tolerance: depth (m) not counted as inside.
+    Returns (count, depths): depths (N,) float32 metres inside (0 for points outside).
+    """
+    surface = body_surface(body_faces)
+    q = query(body_vertices, surface, points, k=6)
+    depth = np.maximum(-q.distance, 0.0).astype(np.float32)
+    return int(np.count_nonzero(depth > tolerance)), depth
+
+
+def push_out(points: np.ndarray, q: SurfaceQuery, clearance: np.ndarray | float) -> np.ndarray:
+    """(N, 3) float32 points moved along the body normal until each is ``clearance`` (m,
+    scalar or (N,)) outside the body; points already that far out do not move."""
+    lack = np.maximum(np.asarray(clearance, dtype=np.float32) - q.distance, 0.0)
+    return (np.asarray(points, dtype=np.float32) + lack[:, None] * q.normal).astype(np.float32)
