@@ -496,6 +496,7 @@ def _rest_positions(data: BvhData) -> np.ndarray:
 
 def _path_length(data: BvhData, a: int, b: int) -> float:
     """Length along the bones between joints a and b (pose independent, file units)."""
+
     def chain(j: int) -> list[int]:
         out = [j]
         while data.parents[out[-1]] >= 0:
