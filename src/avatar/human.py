@@ -152,3 +152,57 @@ class Human:
         mats = kinematics.skinning_matrices(self.skeleton, world)
         skin = skinning.dual_quaternion if method == "dqs" else skinning.linear_blend
         return skin(self.vertices, self.weights, mats)
+
+    # ------------------------------------------------------------------ export
+    def part_skin(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Skin weights ``(indices (V, K), weights (V, K))`` of a part's vertices."""
+        w = self.weights.subset(self.part_vertices(name))
+        return w.indices, w.weights
+
+    def parts(self) -> list:
+        """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments)."""
+        from avatar.part import MeshPart
+
+        out = []
+        for name in BODY_PART_GROUPS:
+            out.append(MeshPart(name, self.part(name), self.material(name), self.part_skin(name)))
+        return out
+
+    def material(self, part: str):
+        """The generated material of a body part (procedural skin or eye)."""
+        from avatar import skin
+
+        p = self.model.defaults() | self.recipe.params
+        if part == "eyes":
+            return skin.eye_material()
+        return skin.skin_material(
+            african=p["african"], asian=p["asian"], caucasian=p["caucasian"], age=p["age"]
+        )
+
+    # ------------------------------------------------------------------ MakeHuman files
+    @classmethod
+    def from_mhm(
+        cls, path: str, model: BodyModel | None = None, rig: str | None = None
+    ) -> Human:
+        """A human from a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes)."""
+        from avatar.io import mhm
+
+        character = mhm.read(path)
+        params = {**character.modifiers, **character.avatar_params}
+        recipe = Recipe(clothes=tuple(c.split()[0] for c in character.clothes))
+        return cls(params, rig or character.rig or "default", model, recipe)
+
+    def to_mhm(self, name: str = "avatar"):
+        """This human as a MakeHuman character file record (``avatar.io.mhm``)."""
+        from avatar.io import mhm
+
+        out = mhm.CharacterFile(name=name, skeleton=f"{self.recipe.rig}.mhskel")
+        values = self.model.defaults() | self.recipe.params
+        for key, value in values.items():
+            p = self.model.parameters[key]
+            if p.mhm_name:
+                out.modifiers[p.mhm_name] = value
+            else:
+                out.avatar_params[key] = value
+        out.clothes = list(self.recipe.clothes)
+        return out

@@ -1,0 +1,194 @@
+"""The ``avatar`` command: one small function per subcommand."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from avatar.errors import AvatarError, ParameterError
+
+log = logging.getLogger("avatar")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit status (0 ok, 1 Avatar error, 2 usage error)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(levelname)s: %(message)s")  # fmt: skip
+    if not hasattr(args, "run"):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.run(args) or 0)
+    except AvatarError as exc:
+        print(f"avatar: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("avatar: interrupted", file=sys.stderr)
+        return 130
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="avatar",
+        description="Create realistic, rigged, dressed and animated 3D humans "
+        "(MakeHuman body model).",
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    sub = parser.add_subparsers(title="commands", metavar="COMMAND")
+    _add_create(sub)
+    _add_info(sub)
+    _add_optional(sub)
+    return parser
+
+
+def _add_create(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "create",
+        help="make a human and write it to a file",
+        description="Make a human (optionally from a MakeHuman .mhm file), shape it, rig it, "
+        "dress it, animate it, and write it. The output suffix picks the format: "
+        ".glb/.gltf, .obj, .mhm, .bvh (the motion on the rig), .fbx/.usd/.blend (via Blender).",
+        epilog="examples:\n  avatar create -o human.glb\n"
+        "  avatar create --set gender=1 --set age=0.8 --set pca/belly=1.5 --rig game_engine "
+        "-o old.glb --render old.png\n  avatar create me.mhm --pose t-pose -o me.obj",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("character", nargs="?", help="a MakeHuman .mhm character file to start from")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="set a parameter (see `avatar info --params`); repeatable")
+    p.add_argument("--measure", action="append", default=[], metavar="NAME=CM",
+                   help="solve the body for a measurement in cm: height, chest, waist, hips; "
+                   "repeatable (e.g. --measure height=180 --measure waist=85)")
+    p.add_argument("--rig", help="skeleton: default, default_no_toes, game_engine, "
+                   "game_engine_with_breast, cmu_mb, mixamo (default: default)")
+    p.add_argument("--pose", metavar="NAME|FILE",
+                   help="static pose: rest, a-pose, t-pose, or a .bvh file (its first frame)")
+    p.add_argument("--wear", action="append", default=[], metavar="NAME|PATH",
+                   help="garment from the library or a .mhclo file; repeatable")
+    p.add_argument("--motion", metavar="CLIP.bvh", help="BVH motion to retarget onto the human")
+    p.add_argument("--frames", metavar="A:B", help="frame range of the motion (Python slice)")
+    p.add_argument("--fps", type=float, help="resample the motion to this frame rate")
+    p.add_argument("--in-place", action="store_true", help="remove the motion's root travel")
+    p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
+    p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")
+    p.set_defaults(run=run_create)
+
+
+def _add_info(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("info", help="list parameters, rigs and assets",
+                       description="List parameters (name, range, default), rigs and assets.")
+    p.add_argument("--params", action="store_true", help="list every parameter")
+    p.add_argument("--search", metavar="TEXT", help="only parameters whose name contains TEXT")
+    p.set_defaults(run=run_info)
+
+
+def _add_optional(sub: argparse._SubParsersAction) -> None:
+    """Subcommands owned by other packages (clothes, motion), added when present."""
+    try:
+        from avatar.clothes.library import add_cli as add_clothes
+    except ImportError:
+        add_clothes = None
+    try:
+        from avatar.motion.cli import add_cli as add_motion
+    except ImportError:
+        add_motion = None
+    for add in (add_clothes, add_motion):
+        if add is not None:
+            add(sub)
+
+
+def parse_assignments(items: Sequence[str]) -> dict[str, float]:
+    """["gender=1", "pca/belly=1.5"] -> {"gender": 1.0, "pca/belly": 1.5}."""
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise ParameterError(f"--set expects NAME=VALUE, got {item!r}")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ParameterError(f"--set {name}: {value!r} is not a number") from None
+    return out
+
+
+def run_create(args: argparse.Namespace) -> int:
+    from avatar import assets
+    from avatar.body.model import BodyModel
+    from avatar.export import save
+    from avatar.human import Human
+
+    model = BodyModel(assets.load(progress=True))
+    params = parse_assignments(args.set)
+    if args.character:
+        base = Human.from_mhm(args.character, model, args.rig)
+        human = Human(base.params | params, args.rig or base.recipe.rig, model, base.recipe)
+    else:
+        human = Human(params, args.rig or "default", model)
+    if args.measure:
+        from avatar.body import measures
+
+        wanted = {k: v / 100.0 for k, v in parse_assignments(args.measure).items()}
+        solved, got = measures.fit(model, wanted, human.params)
+        log.info("measurements: %s", ", ".join(f"{k} {v * 100:.1f} cm" for k, v in got.items()))
+        human = Human(solved, human.recipe.rig, model, human.recipe)
+    human = _dress(human, args.wear)
+    animation = _animation(human, args)
+    path = save(human, args.output, animation)
+    log.info("wrote %s", path)
+    if args.render:
+        from avatar.blender.render import render_human
+
+        log.info("rendered %s", render_human(human, args.render, animation))
+    return 0
+
+
+def _dress(human, wear: list[str]):
+    if not wear:
+        return human
+    from avatar.clothes.library import dress_human
+
+    return dress_human(human, wear)
+
+
+def _animation(human, args: argparse.Namespace):
+    if args.motion:
+        from avatar.motion.cli import motion_for_human
+
+        return motion_for_human(human, args.motion, args.frames, args.fps, args.in_place)
+    if args.pose:
+        if Path(args.pose).suffix.lower() == ".bvh":
+            from avatar.motion.cli import motion_for_human
+
+            return motion_for_human(human, args.pose, "0:1", None, True)
+        return human.pose(args.pose)
+    return None
+
+
+def run_info(args: argparse.Namespace) -> int:
+    from avatar import assets
+    from avatar.body.model import BodyModel
+
+    compiled = assets.load(progress=True)
+    model = BodyModel(compiled)
+    params = model.parameters.values()
+    print(f"assets: {compiled.meta['source']}\ncache:  {compiled.folder}")
+    print(f"rigs:   {', '.join(assets.RIG_NAMES)}")
+    kinds: dict[str, int] = {}
+    for p in params:
+        kinds[p.kind] = kinds.get(p.kind, 0) + 1
+    print("parameters: " + ", ".join(f"{n} {k}s" for k, n in kinds.items()))
+    if args.params or args.search:
+        for p in params:
+            if args.search and args.search.lower() not in p.name.lower():
+                continue
+            print(f"  {p.name:60s} {p.kind:10s} [{p.minimum:g}, {p.maximum:g}] default {p.default:g}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,68 @@
+"""Write a human to a file; the suffix picks the format (the one suffix registry)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from avatar.errors import AvatarError
+from avatar.human import Human
+from avatar.rig.skeleton import Animation
+
+
+def _mhm(human: Human, path: Path, animation: Animation | None) -> None:
+    from avatar.io import mhm
+
+    mhm.write(path, human.to_mhm(path.stem))
+
+
+def _obj(human: Human, path: Path, animation: Animation | None) -> None:
+    from avatar.io import obj
+
+    mesh = human.mesh
+    if animation is not None:  # an OBJ holds one pose: the animation's first frame
+        mesh = mesh.with_vertices(human.posed(animation, slice(0, 1))[0][human.part_vertices("body")])
+    obj.write(path, mesh)
+
+
+def _gltf(human: Human, path: Path, animation: Animation | None) -> None:
+    from avatar.io import gltf
+
+    gltf.write(path, human.parts(), human.skeleton, [animation] if animation is not None else [])
+
+
+def _blender(human: Human, path: Path, animation: Animation | None) -> None:
+    from avatar.blender import export, scene
+
+    scene.clear_scene()
+    built = scene.build_character(scene.character_from_human(human, animation=animation))
+    export.export(path, [built.root, *built.parts])
+
+
+WRITERS: dict[str, Callable[[Human, Path, Animation | None], None]] = {
+    ".mhm": _mhm,
+    ".obj": _obj,
+    ".glb": _gltf,
+    ".gltf": _gltf,
+    ".fbx": _blender,
+    ".usd": _blender,
+    ".usdc": _blender,
+    ".usda": _blender,
+    ".blend": _blender,
+}
+
+
+def save(human: Human, path: str | os.PathLike[str], animation: Animation | None = None) -> Path:
+    """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
+
+    Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
+    (the skin mesh), .mhm (MakeHuman character file), .fbx/.usd/.blend (through Blender).
+    """
+    path = Path(path)
+    writer = WRITERS.get(path.suffix.lower())
+    if writer is None:
+        raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    writer(human, path, animation)
+    return path
