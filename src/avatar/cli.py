@@ -141,7 +141,7 @@ def run_create(args: argparse.Namespace) -> int:
     path = save(human, args.output, animation)
     log.info("wrote %s", path)
     if args.render:
-        from avatar.blender.render import render_human
+        from avatar.blender.picture import render_human
 
         log.info("rendered %s", render_human(human, args.render, animation))
     return 0

@@ -1,0 +1,28 @@
+"""One picture of one human: what ``avatar create --render`` writes."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import bpy
+
+from avatar.blender import render, scene
+from avatar.rig.skeleton import Animation
+
+
+def render_human(
+    human: object,
+    path: str | os.PathLike[str],
+    animation: Animation | None = None,
+    engine: str = "CYCLES",
+    samples: int = 32,
+    resolution: tuple[int, int] = (640, 960),
+) -> Path:
+    """Render ``human`` (at the middle frame of ``animation``, if any) to a PNG."""
+    character = scene.character_from_human(human, animation=animation)
+    render.stage_characters([character], resolution, direction=(0.35, -1.0, 0.15))
+    if animation is not None and animation.frames > 1:
+        sc = bpy.context.scene
+        sc.frame_set(sc.frame_start + animation.frames // 2)
+    return render.render(path, engine=engine, samples=samples, resolution=resolution)
