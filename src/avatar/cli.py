@@ -59,29 +59,58 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("character", nargs="?", help="a MakeHuman .mhm character file to start from")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="set a parameter (see `avatar info --params`); repeatable")
-    p.add_argument("--measure", action="append", default=[], metavar="NAME=CM",
-                   help="solve the body for a measurement in cm: height, chest, waist, hips; "
-                   "repeatable (e.g. --measure height=180 --measure waist=85)")
-    p.add_argument("--rig", help="skeleton: default, default_no_toes, game_engine, "
-                   "game_engine_with_breast, cmu_mb, mixamo (default: default)")
-    p.add_argument("--pose", metavar="NAME|FILE",
-                   help="static pose: rest, a-pose, t-pose, or a .bvh file (its first frame)")
-    p.add_argument("--wear", action="append", default=[], metavar="NAME|PATH",
-                   help="garment from the library or a .mhclo file; repeatable")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set a parameter (see `avatar info --params`); repeatable",
+    )
+    p.add_argument(
+        "--measure",
+        action="append",
+        default=[],
+        metavar="NAME=CM",
+        help="solve the body for a measurement in cm: height, chest, waist, hips; "
+        "repeatable (e.g. --measure height=180 --measure waist=85)",
+    )
+    p.add_argument(
+        "--rig",
+        help="skeleton: default, default_no_toes, game_engine, "
+        "game_engine_with_breast, cmu_mb, mixamo (default: default)",
+    )
+    p.add_argument(
+        "--pose",
+        metavar="NAME|FILE",
+        help="static pose: rest, a-pose, t-pose, or a .bvh file (its first frame)",
+    )
+    p.add_argument(
+        "--wear",
+        action="append",
+        default=[],
+        metavar="NAME|PATH",
+        help="garment from the library or a .mhclo file; repeatable",
+    )
     p.add_argument("--motion", metavar="CLIP.bvh", help="BVH motion to retarget onto the human")
     p.add_argument("--frames", metavar="A:B", help="frame range of the motion (Python slice)")
     p.add_argument("--fps", type=float, help="resample the motion to this frame rate")
     p.add_argument("--in-place", action="store_true", help="remove the motion's root travel")
+    p.add_argument(
+        "--expressions",
+        action="store_true",
+        help="glTF: include the 52 ARKit face units as morph targets",
+    )
     p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
     p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")
     p.set_defaults(run=run_create)
 
 
 def _add_info(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("info", help="list parameters, rigs and assets",
-                       description="List parameters (name, range, default), rigs and assets.")
+    p = sub.add_parser(
+        "info",
+        help="list parameters, rigs and assets",
+        description="List parameters (name, range, default), rigs and assets.",
+    )
     p.add_argument("--params", action="store_true", help="list every parameter")
     p.add_argument("--search", metavar="TEXT", help="only parameters whose name contains TEXT")
     p.set_defaults(run=run_info)
@@ -138,7 +167,7 @@ def run_create(args: argparse.Namespace) -> int:
         human = Human(solved, human.recipe.rig, model, human.recipe)
     human = _dress(human, args.wear)
     animation = _animation(human, args)
-    path = save(human, args.output, animation)
+    path = save(human, args.output, animation, args.expressions)
     log.info("wrote %s", path)
     if args.render:
         from avatar.blender.picture import render_human
@@ -186,7 +215,9 @@ def run_info(args: argparse.Namespace) -> int:
         for p in params:
             if args.search and args.search.lower() not in p.name.lower():
                 continue
-            print(f"  {p.name:60s} {p.kind:10s} [{p.minimum:g}, {p.maximum:g}] default {p.default:g}")
+            print(
+                f"  {p.name:60s} {p.kind:10s} [{p.minimum:g}, {p.maximum:g}] default {p.default:g}"
+            )
     return 0
 
 

@@ -11,28 +11,32 @@ from avatar.human import Human
 from avatar.rig.skeleton import Animation
 
 
-def _mhm(human: Human, path: Path, animation: Animation | None) -> None:
+def _mhm(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
     from avatar.io import mhm
 
     mhm.write(path, human.to_mhm(path.stem))
 
 
-def _obj(human: Human, path: Path, animation: Animation | None) -> None:
+def _obj(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
     from avatar.io import obj
 
     mesh = human.mesh
     if animation is not None:  # an OBJ holds one pose: the animation's first frame
-        mesh = mesh.with_vertices(human.posed(animation, slice(0, 1))[0][human.part_vertices("body")])
+        mesh = mesh.with_vertices(
+            human.posed(animation, slice(0, 1))[0][human.part_vertices("body")]
+        )
     obj.write(path, mesh)
 
 
-def _gltf(human: Human, path: Path, animation: Animation | None) -> None:
+def _gltf(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
     from avatar.io import gltf
 
-    gltf.write(path, human.parts(), human.skeleton, [animation] if animation is not None else [])
+    gltf.write(
+        path, human.parts(expressions), human.skeleton, [animation] if animation is not None else []
+    )
 
 
-def _blender(human: Human, path: Path, animation: Animation | None) -> None:
+def _blender(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
     from avatar.blender import export, scene
 
     scene.clear_scene()
@@ -40,7 +44,7 @@ def _blender(human: Human, path: Path, animation: Animation | None) -> None:
     export.export(path, [built.root, *built.parts])
 
 
-WRITERS: dict[str, Callable[[Human, Path, Animation | None], None]] = {
+WRITERS: dict[str, Callable[[Human, Path, Animation | None, bool], None]] = {
     ".mhm": _mhm,
     ".obj": _obj,
     ".glb": _gltf,
@@ -53,9 +57,15 @@ WRITERS: dict[str, Callable[[Human, Path, Animation | None], None]] = {
 }
 
 
-def save(human: Human, path: str | os.PathLike[str], animation: Animation | None = None) -> Path:
+def save(
+    human: Human,
+    path: str | os.PathLike[str],
+    animation: Animation | None = None,
+    expressions: bool = False,
+) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
+    expressions: include the 52 ARKit face units as morph targets (glTF only).
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
     (the skin mesh), .mhm (MakeHuman character file), .fbx/.usd/.blend (through Blender).
     """
@@ -64,5 +74,5 @@ def save(human: Human, path: str | os.PathLike[str], animation: Animation | None
     if writer is None:
         raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    writer(human, path, animation)
+    writer(human, path, animation, expressions)
     return path

@@ -159,13 +159,28 @@ class Human:
         w = self.weights.subset(self.part_vertices(name))
         return w.indices, w.weights
 
-    def parts(self) -> list:
-        """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments)."""
+    def parts(self, expressions: bool = False) -> list:
+        """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
+
+        expressions: attach the 52 ARKit face units to the body as morph targets.
+        """
         from avatar.part import MeshPart
 
         out = []
         for name in BODY_PART_GROUPS:
-            out.append(MeshPart(name, self.part(name), self.material(name), self.part_skin(name)))
+            morphs = self.expression_morphs() if expressions and name == "body" else {}
+            part = MeshPart(name, self.part(name), self.material(name), self.part_skin(name), morphs)
+            out.append(part)
+        return out
+
+    def expression_morphs(self) -> dict[str, np.ndarray]:
+        """ARKit face unit name -> (13380, 3) float32 body-vertex deltas (metres)."""
+        body = self.part_vertices("body")
+        out = {}
+        for name in self.model.target_names:
+            if name.startswith("faceunits/"):
+                delta = self.model.displacement({"expression/" + name[10:]: 1.0})
+                out[name[10:]] = delta[body]
         return out
 
     def material(self, part: str):

@@ -135,8 +135,8 @@ class BodyModel:
 
         Returns (macro rows (m,), their weights (m,), local target ids (n,), weights (n,)).
         """
-        mw = self.macro_table.weights(values)
-        rows = np.flatnonzero(mw)
+        mw = self.macro_table.weights(values) if any(k in values for k in macros.MACROS) else None
+        rows = np.flatnonzero(mw) if mw is not None else np.zeros(0, np.int64)
         local_ids, local_w = [], []
         for name, v in values.items():
             if v == 0.0 or "/" not in name:
@@ -151,14 +151,18 @@ class BodyModel:
                 assert target is not None
                 local_ids.append(self.target_id[target])
                 local_w.append(abs(v))
-        return rows, mw[rows], np.asarray(local_ids, np.int64), np.asarray(local_w, np.float64)
+        row_w = mw[rows] if mw is not None else np.zeros(0)
+        return rows, row_w, np.asarray(local_ids, np.int64), np.asarray(local_w, np.float64)
 
     @cached_property
     def _modifier_by_name(self) -> dict[str, Modifier]:
         return {m.name: m for m in self.modifiers}
 
     def displacement(self, values: Mapping[str, float]) -> np.ndarray:
-        """(V, 3) float32 sum of the weighted targets of resolved ``values``."""
+        """(V, 3) float32 sum of the weighted targets of resolved ``values``.
+
+        Macro targets count only when ``values`` names a macro (``shape`` passes all of them).
+        """
         rows, row_w, ids, ids_w = self.target_weights(values)
         flat = np.zeros(self._macro_dense.shape[1], dtype=np.float32)
         scratch = np.empty_like(flat)
