@@ -48,8 +48,12 @@ class BodySurface:
 def body_surface(faces: np.ndarray) -> BodySurface:
     """Precompute the triangle one-rings of a body's faces (F, 3|4) int32."""
     faces = np.asarray(faces, dtype=np.int32)
-    tris = faces if faces.shape[1] == 3 else np.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]])
-    tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])]
+    tris = (
+        faces if faces.shape[1] == 3 else np.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]])
+    )
+    tris = tris[
+        (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
+    ]
     vert = tris.ravel()
     tri = np.repeat(np.arange(len(tris), dtype=np.int32), 3)
     order = np.argsort(vert, kind="stable")
@@ -103,7 +107,9 @@ def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndar
     bary = np.stack([u, v, w], axis=-1)
     bary = _edge(bary, (vc <= 0) & (d1 >= 0) & (d3 <= 0), d1, d1 - d3, 0, 1)
     bary = _edge(bary, (vb <= 0) & (d2 >= 0) & (d6 <= 0), d2, d2 - d6, 0, 2)
-    bary = _edge(bary, (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), d4 - d3, (d4 - d3) + (d5 - d6), 1, 2)
+    bary = _edge(
+        bary, (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), d4 - d3, (d4 - d3) + (d5 - d6), 1, 2
+    )
     bary = _corner(bary, (d1 <= 0) & (d2 <= 0), 0)
     bary = _corner(bary, (d3 >= 0) & (d4 <= d3), 1)
     bary = _corner(bary, (d6 >= 0) & (d5 <= d6), 2)

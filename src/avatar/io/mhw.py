@@ -54,7 +54,11 @@ def loads(text: str, path: str | os.PathLike[str] | None = None) -> BoneWeights:
         raise FormatError(path, 0, "negative vertex index or non-finite weight")
     meta = {k: v for k, v in data.items() if k != "weights"}
     return BoneWeights(
-        bones, arr[:, 0].astype(np.int32), arr[:, 1].astype(np.int32), arr[:, 2].astype(np.float32), meta
+        bones,
+        arr[:, 0].astype(np.int32),
+        arr[:, 1].astype(np.int32),
+        arr[:, 2].astype(np.float32),
+        meta,
     )
 
 
