@@ -91,7 +91,7 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
         metavar="NAME|PATH",
         help="garment from the library or a .mhclo file; repeatable",
     )
-    p.add_argument("--motion", metavar="CLIP.bvh", help="BVH motion to retarget onto the human")
+    p.add_argument("--motion", metavar="CLIP.bvh", help="BVH motion to retarget onto the human, or a built-in one: walk")
     p.add_argument("--frames", metavar="A:B", help="frame range of the motion (Python slice)")
     p.add_argument("--fps", type=float, help="resample the motion to this frame rate")
     p.add_argument("--in-place", action="store_true", help="remove the motion's root travel")
@@ -185,6 +185,10 @@ def _dress(human, wear: list[str]):
 
 
 def _animation(human, args: argparse.Namespace):
+    from avatar.motion.procedural import MOTIONS
+
+    if args.motion in MOTIONS:
+        return MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0)
     if args.motion:
         from avatar.motion.cli import motion_for_human
 

@@ -1,0 +1,87 @@
+"""Built-in procedural motions, so a character can move with no motion-capture file.
+
+A walk cycle written as joint angles about world axes (sagittal swing of hips, knees,
+ankles, shoulders and elbows, pelvis yaw and bob), converted into each bone's rest frame.
+It drives MakeHuman's default-family rigs (default, default_no_toes, game_engine*) by name;
+other rigs receive it through retargeting.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar.errors import AvatarError
+from avatar.rig import quaternion
+from avatar.rig.skeleton import Animation, Skeleton
+
+X, Z = np.array([1.0, 0, 0]), np.array([0, 0, 1.0])
+
+# bone -> (world axis, amplitude deg, phase rad, offset deg, swing of the right side)
+WALK = {
+    "upperleg01": (X, -24.0, 0.0, 0.0),
+    "lowerleg01": (X, 28.0, -1.2, 30.0),
+    "foot": (X, 12.0, -0.6, 0.0),
+    "upperarm01": (X, 18.0, np.pi, 0.0),
+    "lowerarm01": (X, -10.0, np.pi, -12.0),
+}
+ALIASES = {"upperleg01": ("upperleg01", "thigh"), "lowerleg01": ("lowerleg01", "calf"),
+           "foot": ("foot",), "upperarm01": ("upperarm01", "upperarm"),
+           "lowerarm01": ("lowerarm01", "lowerarm")}  # fmt: skip
+
+
+def walk(
+    skeleton: Skeleton, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0
+) -> Animation:
+    """A walk of ``seconds`` along -Y at ``cadence`` strides (two steps) per second.
+
+    Stride length scales with leg length, so every body walks at its own natural speed.
+    """
+    t = np.arange(int(round(seconds * fps))) / fps
+    phase = 2 * np.pi * cadence * t
+    j = len(skeleton.names)
+    rot = np.zeros((len(t), j, 4))
+    rot[..., 0] = 1.0
+    trans = np.zeros((len(t), j, 3))
+    for key, (axis, amp, shift, offset) in WALK.items():
+        for side, sign in ((".L", 0.0), (".R", np.pi)):
+            bone = _find(skeleton, key, side)
+            if bone is None:
+                continue
+            angle = np.radians(offset + amp * np.sin(phase + shift + sign))
+            if key == "lowerleg01":  # knees only bend one way
+                angle = np.radians(offset * 0.2) + np.maximum(angle - np.radians(offset * 0.8), 0)
+            rot[:, bone] = _local(skeleton, bone, quaternion.from_axis_angle(axis, angle))
+    root = int(np.flatnonzero(skeleton.parents < 0)[0])
+    legs = _leg_length(skeleton)
+    world = np.zeros((len(t), 3))
+    world[:, 1] = -1.1 * legs * cadence * t  # stride ~ 1.1 leg lengths per cycle... per step pair
+    world[:, 2] = 0.015 * legs * np.cos(2 * phase)
+    trans[:, root] = world @ skeleton.rest[root, :3, :3]  # world offset -> root's rest frame
+    rot[:, root] = _local(
+        skeleton, root, quaternion.from_axis_angle(Z, np.radians(4) * np.sin(phase))
+    )
+    return Animation(rot, trans, fps, skeleton.names)
+
+
+def _find(skeleton: Skeleton, key: str, side: str) -> int | None:
+    for stem in ALIASES[key]:
+        for name in (stem + side, stem + "_" + side[1:].lower(), stem + side.lower()):
+            if name in skeleton.names:
+                return skeleton.names.index(name)
+    return None
+
+
+def _local(skeleton: Skeleton, bone: int, q_world: np.ndarray) -> np.ndarray:
+    """A rotation about a world axis through the bone's head, in the bone's rest frame."""
+    q_rest = quaternion.from_matrix(skeleton.rest[bone, :3, :3])
+    return quaternion.multiply(quaternion.conjugate(q_rest), quaternion.multiply(q_world, q_rest))
+
+
+def _leg_length(skeleton: Skeleton) -> float:
+    thigh = _find(skeleton, "upperleg01", ".L")
+    if thigh is None:
+        raise AvatarError("the procedural walk needs a MakeHuman-style rig (upperleg01.L, ...)")
+    return float(skeleton.heads[thigh, 2] - 0.0)
+
+
+MOTIONS = {"walk": walk}
