@@ -91,7 +91,9 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
         metavar="NAME|PATH",
         help="garment from the library or a .mhclo file; repeatable",
     )
-    p.add_argument("--motion", metavar="CLIP.bvh", help="BVH motion to retarget onto the human, or a built-in one: walk")
+    p.add_argument(
+        "--motion", metavar="CLIP.bvh", help="BVH clip to retarget onto the human, or: walk"
+    )
     p.add_argument("--frames", metavar="A:B", help="frame range of the motion (Python slice)")
     p.add_argument("--fps", type=float, help="resample the motion to this frame rate")
     p.add_argument("--in-place", action="store_true", help="remove the motion's root travel")

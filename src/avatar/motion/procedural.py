@@ -54,7 +54,7 @@ def walk(
     root = int(np.flatnonzero(skeleton.parents < 0)[0])
     legs = _leg_length(skeleton)
     world = np.zeros((len(t), 3))
-    world[:, 1] = -1.1 * legs * cadence * t  # stride ~ 1.1 leg lengths per cycle... per step pair
+    world[:, 1] = -1.1 * legs * cadence * t  # a stride (two steps) ~ 1.1 leg lengths
     world[:, 2] = 0.015 * legs * np.cos(2 * phase)
     trans[:, root] = world @ skeleton.rest[root, :3, :3]  # world offset -> root's rest frame
     rot[:, root] = _local(
