@@ -1,0 +1,68 @@
+"""Avatar: create rigged, dressed, animated MakeHuman humans from Blender's sidebar.
+
+An extension for Blender 4.2+ (blender_manifest.toml) that also loads as a legacy add-on
+(bl_info) in older Blenders, e.g. 3.4 for the UI smoke test. The ``avatar`` library is
+imported lazily by the operators, so the panels register even when it is missing and say
+how to install it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+bl_info = {  # legacy add-ons only; Blender 4.2+ reads blender_manifest.toml
+    "name": "Avatar",
+    "author": "Avatar developers",
+    "version": (0, 0, 0),
+    "blender": (3, 4, 0),
+    "location": "View3D > Sidebar > Avatar",
+    "description": "Rigged, dressed, animated humans from the MakeHuman body model",
+    "category": "Add Mesh",
+}
+
+
+def _add_library_path() -> None:
+    """Legacy installs: ``AVATAR_PYTHONPATH`` (os.pathsep-separated) points at the library."""
+    for entry in reversed(os.environ.get("AVATAR_PYTHONPATH", "").split(os.pathsep)):
+        if entry and entry not in sys.path:
+            sys.path.insert(0, entry)
+
+
+_add_library_path()
+
+import bpy  # noqa: E402
+
+from . import operators, panels, properties  # noqa: E402
+
+CLASSES = (
+    properties.AvatarTarget,
+    properties.AvatarGarment,
+    properties.AvatarSettings,
+    properties.AvatarPreferences,
+    operators.AVATAR_OT_create_human,
+    operators.AVATAR_OT_update_human,
+    operators.AVATAR_OT_load_recipe,
+    operators.AVATAR_OT_add_target,
+    operators.AVATAR_OT_remove_target,
+    operators.AVATAR_OT_refresh_library,
+    operators.AVATAR_OT_wear,
+    operators.AVATAR_OT_take_off,
+    operators.AVATAR_OT_apply_motion,
+    panels.AVATAR_UL_garments,
+    panels.AVATAR_PT_body,
+    panels.AVATAR_PT_dress,
+    panels.AVATAR_PT_motion,
+)
+
+
+def register() -> None:
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.avatar = bpy.props.PointerProperty(type=properties.AvatarSettings)
+
+
+def unregister() -> None:
+    del bpy.types.Scene.avatar
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,152 @@
+"""Characters in a Blender scene that remember their recipe and regenerate from it.
+
+The Blender extension's operators call these functions, one per button. A character's root
+object (its armature) stores the recipe as JSON in the ``avatar_recipe`` custom property;
+changing a slider, wearing a garment or applying a motion edits that recipe and rebuilds the
+character from it, in place (same name, location and collection).
+
+A recipe is what ``avatar.human.Human.to_recipe()`` returns and ``Human.from_recipe()``
+accepts: a JSON-able dict (body parameters, rig, clothes, motion).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+
+import bpy
+
+from avatar.blender import scene as stage
+
+RECIPE_KEY = "avatar_recipe"
+MOTION_KEY = "avatar_motion"  # the Motion panel's spec: {"path", "frames", "fps", "in_place"}
+
+
+def create(
+    recipe: Mapping[str, object], name: str = "Avatar", location=(0.0, 0.0, 0.0)
+) -> stage.CharacterObjects:
+    """Realise ``recipe`` with the library and add the character to the scene.
+
+    Raises AvatarError (bad parameters, missing assets, ...) before touching the scene.
+    """
+    human = realise(recipe)
+    character = stage.character_from_human(human, name=name, location=tuple(location))
+    if character.recipe is None:  # a Human without to_recipe(): keep what we were given
+        from dataclasses import replace
+
+        character = replace(character, recipe=dict(recipe))
+    return stage.build_character(character)
+
+
+def realise(recipe: Mapping[str, object]) -> object:
+    """The ``avatar.human.Human`` a recipe describes (imported here: the core, not bpy)."""
+    from avatar.human import Human
+
+    return Human.from_recipe(dict(recipe))
+
+
+def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.CharacterObjects:
+    """Rebuild the character ``obj`` belongs to from a new recipe, in place.
+
+    The new human is realised first, so a failing recipe leaves the old character intact.
+    """
+    root = root_of(obj)
+    if root is None:
+        from avatar.errors import AvatarError
+
+        raise AvatarError(f"{obj.name!r} is not part of an Avatar character")
+    human = realise(recipe)
+    name, location = root.name, tuple(root.location)
+    collection = root.users_collection[0] if root.users_collection else None
+    motion = json.loads(root[MOTION_KEY]) if MOTION_KEY in root.keys() else None
+    animation = load_motion(motion, human.skeleton) if motion else None
+    remove(root, drop_collection=False)
+    character = stage.character_from_human(human, name=name, location=location)
+    if character.recipe is None:
+        from dataclasses import replace
+
+        character = replace(character, recipe=dict(recipe))
+    if animation is not None:
+        from dataclasses import replace
+
+        character = replace(character, animation=animation)
+    built = stage.build_character(character, collection)
+    if motion:
+        built.root[MOTION_KEY] = json.dumps(motion)
+    return built
+
+
+def apply_motion(obj: bpy.types.Object, motion: Mapping[str, object]) -> str:
+    """Retarget a BVH clip onto the character ``obj`` belongs to and assign it as its action.
+
+    motion: {"path": BVH file, "frames": [first, last] source frames or None,
+    "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
+    updates re-apply it. Returns a one-line summary.
+    """
+    from avatar.blender import action as action_bridge
+
+    root = root_of(obj)
+    if root is None or root.type != "ARMATURE":
+        from avatar.errors import AvatarError
+
+        raise AvatarError("select a rigged Avatar character first")
+    animation = load_motion(motion, realise(recipe_of(root)).skeleton)
+    action_bridge.apply_animation(root, animation, f"{root.name} motion")
+    root[MOTION_KEY] = json.dumps(dict(motion))
+    return f"{root.name}: {animation.frames} frames at {animation.fps:g} fps"
+
+
+def load_motion(motion: Mapping[str, object], skeleton) -> object:
+    """The Animation of a Motion-panel spec, retargeted onto ``skeleton``."""
+    from avatar.errors import AvatarError
+
+    try:
+        from avatar.motion import retarget_file
+    except ImportError as exc:
+        raise AvatarError("BVH retargeting is not available in this avatar build") from exc
+    frames = motion.get("frames")
+    return retarget_file(
+        motion["path"],
+        skeleton,
+        frames=tuple(frames) if frames else None,
+        fps=motion.get("fps"),
+        in_place=bool(motion.get("in_place")),
+    )
+
+
+def root_of(obj: bpy.types.Object | None) -> bpy.types.Object | None:
+    """The object holding the recipe: ``obj`` or its nearest ancestor that has one."""
+    while obj is not None:
+        if RECIPE_KEY in obj.keys():
+            return obj
+        obj = obj.parent
+    return None
+
+
+def recipe_of(obj: bpy.types.Object | None) -> dict | None:
+    """The recipe stored on the character ``obj`` belongs to, or None."""
+    root = root_of(obj)
+    return json.loads(root[RECIPE_KEY]) if root is not None else None
+
+
+def remove(root: bpy.types.Object, drop_collection: bool = True) -> None:
+    """Delete a character: root, its descendants, their data, its action, and (when
+    ``drop_collection``) the collection named after it once that is empty."""
+    objects = [root, *root.children_recursive]
+    action = root.animation_data.action if root.animation_data else None
+    datas = [o.data for o in objects if o.data is not None]
+    name = root.name
+    for obj in objects:
+        bpy.data.objects.remove(obj)
+    for data in datas:
+        if data.users == 0:
+            _pool(data).remove(data)
+    if action is not None and action.users == 0:
+        bpy.data.actions.remove(action)
+    collection = bpy.data.collections.get(name) if drop_collection else None
+    if collection is not None and not collection.all_objects:
+        bpy.data.collections.remove(collection)
+
+
+def _pool(data: bpy.types.ID):
+    return bpy.data.armatures if isinstance(data, bpy.types.Armature) else bpy.data.meshes
