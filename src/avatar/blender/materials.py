@@ -158,9 +158,9 @@ def image_from_array(name: str, array: np.ndarray, non_color: bool = False) -> b
     rgba = to_rgba(array)
     height, width = rgba.shape[:2]
     image = bpy.data.images.new(name, width, height, alpha=True)
-    image.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).ravel())  # Blender: bottom-up
-    if non_color:
+    if non_color:  # before the pixels: changing a generated image's colour space clears them
         image.colorspace_settings.name = "Non-Color"
+    image.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).ravel())  # Blender: bottom-up
     image.pack()
     return image
 

@@ -21,8 +21,10 @@ def render_human(
 ) -> Path:
     """Render ``human`` (at the middle frame of ``animation``, if any) to a PNG."""
     character = scene.character_from_human(human, animation=animation)
-    render.stage_characters([character], resolution, direction=(0.35, -1.0, 0.15))
+    direction = (0.35, -1.0, 0.15)
+    built = render.stage_characters([character], resolution, direction=direction)[0]
     if animation is not None and animation.frames > 1:
         sc = bpy.context.scene
         sc.frame_set(sc.frame_start + animation.frames // 2)
+        scene.frame_camera(built.parts, direction=direction)  # the character has moved
     return render.render(path, engine=engine, samples=samples, resolution=resolution)
