@@ -1,0 +1,108 @@
+"""Bind any garment mesh to the body, MakeClothes-style, so it fits every body afterwards.
+
+For each garment vertex: the closest point on the reference surface (the skin, or a helper
+such as ``helper-tights``) gives a triangle and barycentric weights; what is left over is
+the offset, divided by the per-axis scale S of the authoring body (MakeHuman's reference
+pairs), so ``fit(bind(...), authoring body)`` gives the garment back to float precision.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid as uuidlib
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from avatar.clothes import collision
+from avatar.clothes.binding import Binding, axis_scale, make_binding
+from avatar.errors import AvatarError
+from avatar.io import mhclo, mhmat, obj
+from avatar.mesh import Mesh
+
+# MakeHuman's standard reference pairs (x: hand to hand width, y: front-back, z: height),
+# as Avatar axes; the lengths are measured on the authoring body.
+SCALE_REFS = np.array([[5399, 11998], [962, 5320], [791, 881]], dtype=np.int32)
+
+
+def bind(
+    garment_vertices: np.ndarray,
+    body_vertices: np.ndarray,
+    body_faces: np.ndarray,
+    max_distance: float = 0.5,
+) -> Binding:
+    """A Binding of N garment vertices to the body they were modelled on.
+
+    garment_vertices: (N, 3) metres, Avatar frame, on the authoring body.
+    body_vertices: (V, 3) all base-mesh vertices of the authoring body (19,158 for hm08).
+    body_faces: (F, 3|4) the reference surface (skin faces, or a helper's faces).
+    max_distance: m; a vertex further than this from the surface cannot be bound.
+    Raises AvatarError naming the first unbindable vertex; nothing is half-built.
+    """
+    x = np.asarray(body_vertices, dtype=np.float64)
+    p = np.asarray(garment_vertices, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3 or len(p) == 0 or not np.all(np.isfinite(p)):
+        raise AvatarError("a garment needs (N, 3) finite vertex positions")
+    surface = collision.body_surface(body_faces)
+    used = np.unique(surface.triangles)
+    tree = cKDTree(x[used])
+    _, nearest = tree.query(p, k=4)
+    cand = surface.rings[used[nearest]].reshape(len(p), -1)
+    tri = surface.triangles[cand]
+    corners = x[tri]
+    pc = p[:, None, :]
+    bary = collision.closest_on_triangles(pc, *(corners[..., i, :] for i in range(3)))
+    close = np.einsum("ncj,ncjd->ncd", bary, corners)
+    dist = np.linalg.norm(pc - close, axis=-1)
+    best = np.argmin(dist, axis=1)
+    rows = np.arange(len(p))
+    far = dist[rows, best] > max_distance
+    if far.any():
+        i = int(np.flatnonzero(far)[0])
+        raise AvatarError(
+            f"garment vertex {i} is {dist[i, best[i]]:.2f} m from the body (limit "
+            f"{max_distance} m): was the garment modelled on an Avatar body, in metres, Z-up?"
+        )
+    weights = bary[rows, best]
+    indices = tri[rows, best]
+    lengths = np.abs(x[SCALE_REFS[:, 0], [0, 1, 2]] - x[SCALE_REFS[:, 1], [0, 1, 2]])
+    binding = make_binding(indices, weights, np.zeros_like(p), SCALE_REFS, lengths)
+    offsets = (p - close[rows, best]) / axis_scale(binding, x)
+    return make_binding(indices, weights, offsets, SCALE_REFS, lengths)
+
+
+def save(
+    folder: str | os.PathLike[str],
+    name: str,
+    mesh: Mesh,
+    binding: Binding,
+    material: mhmat.MaterialFile | None = None,
+    z_depth: int = 50,
+    tags: tuple[str, ...] = (),
+    delete_verts: np.ndarray | None = None,
+) -> Path:
+    """Write ``name.mhclo`` + ``name.obj`` (+ ``name.mhmat``) into folder; returns the .mhclo.
+
+    The OBJ holds the garment as authored (MakeHuman units), as MakeClothes writes it.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    obj.write(folder / f"{name}.obj", mesh, axes=obj.MAKEHUMAN)
+    if material is None:
+        material = mhmat.MaterialFile((("name", name), ("diffuseColor", "0.8 0.8 0.8")))
+    mhmat.write(folder / f"{name}.mhmat", material)
+    proxy = mhclo.ProxyFile(
+        name=name,
+        binding=binding,
+        uuid=str(uuidlib.uuid5(uuidlib.NAMESPACE_URL, f"avatar:{name}")),
+        obj_file=f"{name}.obj",
+        material=f"{name}.mhmat",
+        z_depth=z_depth,
+        tags=tuple(t.lower() for t in tags),
+        delete_verts=np.zeros(0, np.int32) if delete_verts is None else delete_verts,
+        meta=(("author", "avatar"),),
+    )
+    path = folder / f"{name}.mhclo"
+    mhclo.write(path, proxy)
+    return path
