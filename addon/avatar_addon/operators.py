@@ -78,7 +78,7 @@ class AVATAR_OT_update_human(bpy.types.Operator):
     def execute(self, context):
         recipe = context.scene.avatar.recipe(_stored_recipe(context))
         obj = context.object
-        return _call(self, lambda: f"Updated {_character().update(obj, recipe).root.name}")
+        return _call(self, lambda: _rebuild(context, obj, recipe, "Updated"))
 
 
 class AVATAR_OT_load_recipe(bpy.types.Operator):
@@ -167,9 +167,7 @@ class _DressOperator:
         recipe["clothes"] = clothes + [garment] if self.wear else clothes
         obj = context.object
         verb = "Wearing" if self.wear else "Took off"
-        return _call(
-            self, lambda: f"{verb} {garment} on {_character().update(obj, recipe).root.name}"
-        )
+        return _call(self, lambda: _rebuild(context, obj, recipe, f"{verb} {garment} on"))
 
 
 class AVATAR_OT_wear(_DressOperator, bpy.types.Operator):
@@ -203,6 +201,13 @@ class AVATAR_OT_apply_motion(bpy.types.Operator):
         motion = context.scene.avatar.motion()
         obj = context.object
         return _call(self, lambda: _character().apply_motion(obj, motion))
+
+
+def _rebuild(context, obj, recipe, verb):
+    """Rebuild ``obj``'s character from ``recipe``, keep it active; a one-line report."""
+    built = _character().update(obj, recipe)
+    context.view_layer.objects.active = built.root
+    return f"{verb} {built.root.name}"
 
 
 def _stored_recipe(context):

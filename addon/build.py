@@ -1,0 +1,107 @@
+"""Build and validate the Avatar Blender extension zip.
+
+    python addon/build.py [--output dist/] [--blender-ext PATH] [--no-wheel]
+
+Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
+from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``
+and list it in the manifest, then run Blender's own ``blender_ext.py build`` and
+``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
+(``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
+so no Blender binary is needed. Prints the zip's path.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SOURCE = ROOT / "addon" / "avatar_addon"
+STAGE = ROOT / "build" / "extension"
+
+
+def main(argv: list[str] | None = None) -> Path:
+    args = _parse(argv)
+    version = project_version()
+    stage = stage_sources(STAGE / "avatar_addon")
+    wheels = [] if args.no_wheel else [build_wheel(stage / "wheels")]
+    stamp_manifest(stage / "blender_manifest.toml", version, wheels)
+    tool = args.blender_ext or find_blender_ext()
+    args.output.mkdir(parents=True, exist_ok=True)
+    zip_path = args.output.resolve() / f"avatar_addon-{version}.zip"
+    _run(tool, "build", "--source-dir", stage, "--output-filepath", zip_path)
+    _run(tool, "validate", zip_path)
+    print(zip_path)
+    return zip_path
+
+
+def _parse(argv: list[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=ROOT / "dist")
+    parser.add_argument("--blender-ext", type=Path, help="path to blender_ext.py")
+    parser.add_argument(
+        "--no-wheel", action="store_true", help="leave the avatar library out (needs sys.path)"
+    )
+    return parser.parse_args(argv)
+
+
+def project_version() -> str:
+    """The one version, from pyproject.toml."""
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        return tomllib.load(f)["project"]["version"]
+
+
+def stage_sources(stage: Path) -> Path:
+    """A clean copy of the add-on sources (no caches) at ``stage``."""
+    if stage.exists():
+        shutil.rmtree(stage)
+    shutil.copytree(SOURCE, stage, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    return stage
+
+
+def build_wheel(folder: Path) -> Path:
+    """The avatar library as a pure-Python wheel in ``folder`` (no dependencies bundled:
+    Blender ships numpy, and the modules the extension uses import nothing else eagerly)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", folder, ROOT)
+    wheels = sorted(folder.glob("avatar-*.whl"))
+    if not wheels:
+        raise SystemExit(f"pip wheel produced no avatar wheel in {folder}")
+    return wheels[-1]
+
+
+def stamp_manifest(manifest: Path, version: str, wheels: list[Path]) -> None:
+    """Set ``version`` and ``wheels`` (paths relative to the manifest) in place."""
+    text = manifest.read_text()
+    text = re.sub(r'(?m)^version = ".*"$', f'version = "{version}"', text)
+    listed = ", ".join(f'"./wheels/{w.name}"' for w in wheels)
+    text = re.sub(r"(?m)^wheels = \[.*\]$", f"wheels = [{listed}]", text)
+    manifest.write_text(text)
+
+
+def find_blender_ext() -> Path:
+    """blender_ext.py from the installed ``bpy`` module."""
+    spec = importlib.util.find_spec("bpy")
+    if spec is None or spec.origin is None:
+        raise SystemExit("bpy is not installed: pip install bpy==5.0.1, or pass --blender-ext")
+    found = sorted(Path(spec.origin).parent.glob("*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
+    if not found:
+        raise SystemExit("blender_ext.py not found inside the bpy package; pass --blender-ext")
+    return found[-1]
+
+
+def _run(*command: object) -> None:
+    # blender_ext.py only needs the standard library: run it on this interpreter.
+    if str(command[0]).endswith(".py"):
+        command = (sys.executable, *command)
+    subprocess.run([str(c) for c in command], check=True)
+
+
+if __name__ == "__main__":
+    main()
