@@ -1,0 +1,148 @@
+"""Bone correspondence: skeleton bone names -> canonical human bones.
+
+Canonical bones (``hips``, ``spine``, ``chest``, ``neck``, ``head``, ``clavicle.L``,
+``upperarm.L``, ``forearm.L``, ``hand.L``, ``thigh.L``, ``shin.L``, ``foot.L``, ``toe.L``,
+fingers ``thumb1.L`` .. ``pinky3.L``, and the ``.R`` twins) name a bone by its anatomical
+job: its head sits at the joint and it turns the segment up to ``NEXT[bone]``.
+
+Conventions are JSON files (``avatar/data/bonemaps/*.json``: ``{"name", "description",
+"bones": {canonical: [candidate names, first present wins]}}``); a user file of the same
+shape can be passed anywhere a convention name is accepted. Names match case-insensitively
+after dropping any ``prefix:`` (``mixamorig:Hips``, ``mixamorig1:Hips``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from avatar.errors import FormatError, ParameterError, unknown_name
+from avatar.rig.skeleton import Skeleton
+
+_TRUNK = {"hips": "spine", "spine": "chest", "chest": "neck", "neck": "head", "head": None}
+_LIMBS = {"clavicle": "upperarm", "upperarm": "forearm", "forearm": "hand", "hand": "middle1",
+          "thigh": "shin", "shin": "foot", "foot": "toe", "toe": None}  # fmt: skip
+_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
+
+
+def _canonical() -> dict[str, str | None]:
+    out: dict[str, str | None] = dict(_TRUNK)
+    for side in ("L", "R"):
+        for bone, nxt in _LIMBS.items():
+            out[f"{bone}.{side}"] = f"{nxt}.{side}" if nxt else None
+        for f in _FINGERS:
+            for i in (1, 2, 3):
+                out[f"{f}{i}.{side}"] = f"{f}{i + 1}.{side}" if i < 3 else None
+    return out
+
+
+NEXT: dict[str, str | None] = _canonical()
+"""canonical bone -> the canonical bone at the far end of its segment (None: its tail)."""
+
+CORE = tuple(b for b in NEXT if not b.startswith(_FINGERS))
+"""The 21 body bones every humanoid convention has; fingers are optional."""
+
+# Trunk chains whose in-between bones share the bend (spines and necks of any length).
+CHAINS = (("spine", "chest"), ("neck", "head"))
+
+
+def normalise(name: str) -> str:
+    """Match key of a bone name: no ``prefix:`` or ``Armature|``, lower case."""
+    return name.rsplit(":", 1)[-1].rsplit("|", 1)[-1].strip().lower()
+
+
+@dataclass(frozen=True)
+class BoneMap:
+    """Which bone of one skeleton plays each canonical role.
+
+    convention: the convention's name (or the user file's path).
+    bones: canonical name -> bone index in the skeleton.
+    missing: canonical body bones (``CORE``) the skeleton lacks under this convention.
+    """
+
+    convention: str
+    bones: dict[str, int]
+    missing: tuple[str, ...]
+
+    def name_of(self, skeleton: Skeleton, canonical: str) -> str:
+        return skeleton.names[self.bones[canonical]]
+
+
+def conventions() -> dict[str, dict[str, list[str]]]:
+    """All shipped conventions: name -> {canonical: candidate names}."""
+    folder = resources.files("avatar") / "data" / "bonemaps"
+    out = {}
+    for entry in sorted(folder.iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(".json"):
+            data = _parse(entry.read_text(encoding="utf-8"), entry.name)
+            out[data["name"]] = data["bones"]
+    return out
+
+
+def _parse(text: str, path: str) -> dict:
+    """A convention file's JSON, checked: unknown canonical names are errors, not typos."""
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FormatError(path, exc.lineno, exc.msg) from None
+    bones = data.get("bones") if isinstance(data, dict) else None
+    if not isinstance(bones, dict):
+        raise FormatError(path, 0, 'a bone map needs {"bones": {canonical: [names]}}')
+    for key, names in bones.items():
+        if key not in NEXT:
+            raise FormatError(path, 0, str(unknown_name("canonical bone", key, NEXT)))
+        if isinstance(names, str):
+            bones[key] = [names]
+        elif not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
+            raise FormatError(path, 0, f"{key}: expected a name or a list of names")
+    data.setdefault("name", Path(path).stem)
+    return data
+
+
+def load(path: str | os.PathLike[str]) -> dict[str, list[str]]:
+    """A user's bone map file -> {canonical: candidate names}."""
+    return _parse(Path(path).read_text(encoding="utf-8"), str(path))["bones"]
+
+
+def apply(skeleton: Skeleton, table: dict[str, list[str]], name: str = "custom") -> BoneMap:
+    """Resolve a {canonical: candidates} table against a skeleton's bone names."""
+    index = {}
+    for j, n in enumerate(skeleton.names):
+        index.setdefault(normalise(n), j)
+    bones = {}
+    for canonical, candidates in table.items():
+        for cand in candidates:
+            j = index.get(normalise(cand))
+            if j is not None:
+                bones[canonical] = j
+                break
+    missing = tuple(b for b in CORE if b not in bones)
+    return BoneMap(name, bones, missing)
+
+
+def detect(skeleton: Skeleton, convention: str | os.PathLike[str] = "auto") -> BoneMap:
+    """The bone map of a skeleton: by convention name, user file, or "auto" (best match).
+
+    "auto" scores every shipped convention by the body bones it finds and keeps the best
+    (unknown conventions need a bone map file). Raises ParameterError for an unknown
+    convention name or a skeleton without recognisable hips.
+    """
+    known = conventions()
+    if convention != "auto":
+        key = str(convention)
+        if key in known:
+            return apply(skeleton, known[key], key)
+        if Path(key).suffix == ".json" or os.sep in key:
+            return apply(skeleton, load(key), key)
+        raise unknown_name("bone map convention", key, known)
+    maps = [apply(skeleton, table, name) for name, table in known.items()]
+    best = max(maps, key=lambda m: (len(CORE) - len(m.missing), len(m.bones)))
+    if "hips" not in best.bones:
+        raise ParameterError(
+            f"cannot find the hips of this skeleton (best convention {best.convention!r} "
+            f"lacks {', '.join(best.missing)}); pass a bone map file"
+        )
+    return best

@@ -1,0 +1,159 @@
+"""Per-bone rest alignment between a source clip and a target skeleton.
+
+For each pair the offset ``A`` (3x3, target bone frame -> source bone frame) is chosen so the
+target bone's segment runs along the source's and its twist matches an anatomical
+reference seen the same way on both sides: the pelvis/shoulder line for the trunk, the knee
+and elbow hinge axes (estimated from the clip's own bending, so any rest pose works: T, A,
+arms down or Reallusion's folded rest) for limbs, the body's forward axis for clavicles.
+Bones without such a reference (fingers, same-named extras) keep their rest twist relative
+to their parent (shortest-arc alignment of the source's rest).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar.motion import geometry
+from avatar.motion.pairs import Pair, segment_rest, segment_world
+from avatar.rig.skeleton import Skeleton
+
+_BACK = np.array([0.0, 1.0, 0.0])  # Avatar characters face -Y: knees bend toward +Y
+_UP = np.array([0.0, 0.0, 1.0])
+_MIN_BEND = np.sin(np.radians(15.0))
+
+
+class _Side:
+    """Source (T-frame) or target (rest) view of a skeleton: world rotations and heads."""
+
+    def __init__(self, skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray):
+        self.skeleton, self.rot, self.pos = skeleton, rot, pos
+
+    def seg(self, pair: Pair, source: bool) -> np.ndarray:
+        bone, end = (pair.source, pair.source_end) if source else (pair.target, pair.target_end)
+        return segment_world(self.skeleton, self.rot, self.pos, bone, end)
+
+
+def offsets(pairs: list[Pair], source: Skeleton, src_rot: np.ndarray, src_pos: np.ndarray,
+            target: Skeleton) -> np.ndarray:  # fmt: skip
+    """(P, 3, 3) alignment A per pair; target world = source world @ A."""
+    src = _Side(source, src_rot, src_pos)
+    t_rot = target.rest[None, :, :3, :3]
+    tgt = _Side(target, t_rot, target.heads[None])
+    by_role = {p.role: p for p in pairs}
+    refs = _references(by_role, src, tgt)
+    out = np.full((len(pairs), 3, 3), np.nan)
+    for k, pair in enumerate(pairs):
+        ref = refs.get(_reference_name(pair))
+        if ref is None:
+            continue
+        e_s = _local_median(src_rot[:, pair.source], src.seg(pair, True))
+        s_s = _local_median(src_rot[:, pair.source], ref[0])
+        rt = target.rest[pair.target, :3, :3]
+        e_t = segment_rest(target, pair.target, pair.target_end)
+        s_t = rt.T @ ref[1]
+        out[k] = geometry.frame(e_s, s_s) @ geometry.frame(e_t, s_t).T
+    _choose(out, pairs, source, target)
+    return out
+
+
+def _reference_name(pair: Pair) -> str | None:
+    side = pair.role.rsplit(".", 1)[-1] if "." in pair.role else ""
+    kind = pair.kind
+    if pair.role in ("hips", "spine"):
+        return "pelvis"
+    if kind == "trunk":
+        return "shoulders"
+    if kind in ("thigh", "shin", "foot", "toe"):
+        return f"knee.{side}"
+    if kind in ("upperarm", "forearm"):
+        return f"elbow.{side}"
+    if kind == "clavicle":
+        return "forward"
+    return None
+
+
+def _references(by_role: dict[str, Pair], src: _Side, tgt: _Side) -> dict:
+    """name -> ((T, 3) source world vectors, (3,) target world vector)."""
+    refs: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    pelvis = _line(by_role, src, tgt, "thigh")
+    if pelvis is None:
+        return refs
+    refs["pelvis"] = pelvis
+    refs["shoulders"] = _line(by_role, src, tgt, "upperarm") or pelvis
+    fwd_s = np.cross(pelvis[0], _UP)
+    refs["forward"] = (fwd_s, np.cross(pelvis[1], _UP))
+    for side in ("L", "R"):
+        refs[f"knee.{side}"] = _hinge(by_role, src, tgt, f"thigh.{side}", f"shin.{side}",
+                                      _BACK, pelvis)  # fmt: skip
+        refs[f"elbow.{side}"] = _hinge(by_role, src, tgt, f"upperarm.{side}",
+                                       f"forearm.{side}", -_BACK, refs["forward"])  # fmt: skip
+    return refs
+
+
+def _line(by_role, src: _Side, tgt: _Side, role: str):
+    """Right-to-left line between the heads of a bone pair (pelvis or shoulder width)."""
+    left, right = by_role.get(f"{role}.L"), by_role.get(f"{role}.R")
+    if left is None or right is None:
+        return None
+    s = src.pos[:, left.source] - src.pos[:, right.source]
+    t = tgt.pos[0, left.target] - tgt.pos[0, right.target]
+    return s, t
+
+
+def _hinge(by_role, src: _Side, tgt: _Side, upper: str, lower: str, bend: np.ndarray, fallback):
+    """A hinge axis (knee, elbow): from the clip's bent frames in the upper bone's frame,
+    and for the target from its rest direction and the way the joint bends (``bend``)."""
+    up, low = by_role.get(upper), by_role.get(lower)
+    if up is None or low is None:
+        return fallback
+    cross = np.cross(geometry.unit(src.seg(up, True)), geometry.unit(src.seg(low, True)))
+    bent = np.linalg.norm(cross, axis=-1) > _MIN_BEND
+    if bent.sum() < 1:
+        return fallback
+    rot = src.rot[:, up.source]
+    local = geometry.unit(np.median(geometry.unit(np.einsum("tba,tb->ta", rot[bent],
+                                                            cross[bent])), axis=0))  # fmt: skip
+    world_s = rot @ local
+    world_t = geometry.unit(np.cross(tgt.seg(up, False)[0], bend))
+    return world_s, world_t
+
+
+def _local_median(rot: np.ndarray, world: np.ndarray) -> np.ndarray:
+    """(3,) median over frames of world vectors (T, 3) seen in a bone's frames (T, 3, 3)."""
+    local = geometry.unit(np.einsum("tba,tb->ta", rot, world))
+    return geometry.unit(np.median(local, axis=0))
+
+
+def _choose(out: np.ndarray, pairs: list[Pair], source: Skeleton, target: Skeleton):
+    """Walk the source in its reference pose (the pose matching the target's rest): each
+    paired bone turns by the shortest arc from its parent-relative rest onto the target's
+    segment (rest alignment). Where that agrees with the anatomical alignment within
+    ``REST_TRUST`` degrees (compatible rests: same skeleton, T vs A arms), keep it, so a
+    skeleton retargets onto itself exactly; otherwise (folded or twisted rests) take the
+    anatomical one. Pairs without an anatomical reference always use rest alignment."""
+    local = source.local_rest()[:, :3, :3]
+    of_source = {p.source: k for k, p in enumerate(pairs)}
+    ref = np.empty((len(source.names), 3, 3))
+    for j, parent in enumerate(source.parents):
+        base = local[j] if parent < 0 else ref[parent] @ local[j]
+        k = of_source.get(j)
+        if k is None:
+            ref[j] = base
+            continue
+        p, rt = pairs[k], target.rest[pairs[k].target, :3, :3]
+        e_s = segment_rest(source, p.source, p.source_end)
+        want = rt @ segment_rest(target, p.target, p.target_end)
+        g = geometry.swing(base @ e_s, want) @ base
+        rest_aligned = g.T @ rt
+        if np.isnan(out[k, 0, 0]) or _degrees(rest_aligned, out[k]) < REST_TRUST:
+            out[k] = rest_aligned
+        ref[j] = rt @ out[k].T
+
+
+REST_TRUST = 45.0
+
+
+def _degrees(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle of the rotation between two 3x3 rotations, degrees."""
+    c = (np.trace(a.T @ b) - 1.0) / 2.0
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))

@@ -1,0 +1,163 @@
+"""Foot contacts: detect them on the source clip, keep them planted on the target.
+
+A foot joint (ankle or toe) is in contact while it is nearly still (speed below 15% of leg
+length per second) for at least 50 ms; floors at any height (steps, boxes) count. While the
+toe is down the toe is pinned (heel-off pivots about it), else the ankle. The target's leg
+is bent by analytic two-bone IK so the pinned joint stays at its mean position over the
+contact (on the floor when it was within a few cm of it), blending in and out over 0.1 s.
+The foot keeps its retargeted world orientation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar.motion import geometry
+from avatar.motion.bonemap import BoneMap
+from avatar.rig.skeleton import Skeleton
+
+FOOT_ROLES = ("foot.L", "toe.L", "foot.R", "toe.R")
+_SPEED = 0.15  # leg lengths per second
+_NEAR_FLOOR = 0.06  # leg lengths: a contact this close to the floor is put on it
+_MIN_CONTACT_S = 0.05
+_BLEND_S = 0.1
+
+
+@dataclass(frozen=True)
+class FootContacts:
+    """Per side ("L", "R"): which role is pinned each frame ("toe", "foot" or "")."""
+
+    pinned: dict[str, np.ndarray]  # side -> (T,) str array
+
+    def frames(self, side: str) -> np.ndarray:
+        return self.pinned[side] != ""
+
+
+def foot_level(pos: np.ndarray, bmap: BoneMap) -> float:
+    """Height of the lowest foot joint when down (5th percentile over frames), metres."""
+    idx = [bmap.bones[r] for r in FOOT_ROLES if r in bmap.bones]
+    if not idx:
+        return float(np.percentile(pos[..., 2].min(axis=1), 5))
+    return float(np.percentile(pos[:, idx, 2].min(axis=1), 5))
+
+
+def detect(pos: np.ndarray, bmap: BoneMap, fps: float, leg: float) -> FootContacts:
+    """Contacts from source joint paths (T, J, 3); ``leg`` is the source leg length (m)."""
+    pinned = {}
+    for side in ("L", "R"):
+        state = np.full(len(pos), "", dtype="<U4")
+        for role in ("foot", "toe"):  # toe last: it wins when both are down
+            j = bmap.bones.get(f"{role}.{side}")
+            if j is not None:
+                still = _still(pos[:, j], fps, leg)
+                state[still] = role
+        pinned[side] = state
+    return FootContacts(pinned)
+
+
+def _still(path: np.ndarray, fps: float, leg: float) -> np.ndarray:
+    """(T,) bool: the joint moves slower than the threshold, in runs long enough."""
+    if len(path) < 2:
+        return np.zeros(len(path), dtype=bool)
+    step = np.linalg.norm(np.diff(path, axis=0), axis=-1) * fps
+    speed = np.concatenate([[step[0]], np.maximum(step[:-1], step[1:]), [step[-1]]])
+    still = speed < _SPEED * leg
+    return _drop_short(still, max(2, int(round(_MIN_CONTACT_S * fps))))
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) of each run of True."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True))
+
+
+def _drop_short(mask: np.ndarray, length: int) -> np.ndarray:
+    out = mask.copy()
+    for a, b in _runs(mask):
+        if b - a < length:
+            out[a:b] = False
+    return out
+
+
+def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray,
+          root: np.ndarray, fps: float) -> np.ndarray:  # fmt: skip
+    """Bend the target's legs so pinned joints stay put. Returns new world rotations."""
+    world = world.copy()
+    hips = tmap.bones["hips"]
+    legs = [tmap.bones[f"{r}.{s}"] for r in ("thigh", "shin", "foot", "toe") for s in "LR"
+            if f"{r}.{s}" in tmap.bones]  # fmt: skip
+    from avatar.motion.retarget import _ancestors
+
+    pos = geometry.positions(target, world, {hips: root}, _ancestors(target, legs))
+    for side in ("L", "R"):
+        roles = [tmap.bones.get(f"{r}.{side}") for r in ("thigh", "shin", "foot")]
+        if None in roles:
+            continue
+        goal = _ankle_goals(feet.pinned[side], pos, tmap, side, target, fps)
+        if goal is not None:
+            _two_bone_ik(world, pos, target, *roles, goal)  # type: ignore[misc]
+    return world
+
+
+def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: float):
+    """(T, 3) where the ankle should be (NaN: leave it), blended around contacts."""
+    ankle = tmap.bones[f"foot.{side}"]
+    offset = np.zeros((len(pos), 3))
+    weight = np.zeros(len(pos))
+    for role in ("foot", "toe"):
+        j = tmap.bones.get(f"{role}.{side}")
+        if j is None:
+            continue
+        rest_z = target.heads[j, 2]
+        for a, b in _runs(pinned == role):
+            pin = pos[a:b, j].mean(axis=0)
+            if pin[2] - rest_z < _NEAR_FLOOR * _leg(target, tmap, side):
+                pin[2] = rest_z  # a floor contact: exactly on the floor
+            offset[a:b] = pin - pos[a:b, j]
+            weight[a:b] = 1.0
+    if not weight.any():
+        return None
+    offset, weight = _blend(offset, weight, max(1, int(round(_BLEND_S * fps))))
+    return pos[:, ankle] + offset * weight[:, None]
+
+
+def _blend(offset: np.ndarray, weight: np.ndarray, n: int):
+    """Carry each contact's boundary offset into the free frames around it, fading out."""
+    out_o, out_w = offset.copy(), weight.copy()
+    for a, b in _runs(weight > 0):
+        for k in range(1, n + 1):
+            fade = 1.0 - k / (n + 1)
+            for f, src in ((a - k, a), (b - 1 + k, b - 1)):
+                if 0 <= f < len(weight) and weight[f] == 0 and fade > out_w[f]:
+                    out_o[f], out_w[f] = offset[src], fade
+    return out_o, out_w
+
+
+def _leg(target: Skeleton, tmap: BoneMap, side: str) -> float:
+    h = target.heads[[tmap.bones[f"{r}.{side}"] for r in ("thigh", "shin", "foot")]]
+    return float(np.linalg.norm(np.diff(h, axis=0), axis=1).sum())
+
+
+def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int, goal) -> None:
+    """Rotate thigh and shin chains (in place) so the ankle reaches ``goal`` (T, 3)."""
+    from avatar.motion.retarget import _path  # shared tree walk
+
+    h, k, a = pos[:, thigh], pos[:, shin], pos[:, foot]
+    l1 = np.linalg.norm(k - h, axis=-1)
+    l2 = np.linalg.norm(a - k, axis=-1)
+    hinge = np.cross(a - k, h - k)
+    weak = np.linalg.norm(hinge, axis=-1) < 1e-6 * l1 * l2
+    hinge = np.where(weak[:, None], world[:, thigh, :, 0], hinge)  # straight leg: bone X
+    hinge = geometry.unit(hinge)
+    reach = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
+    cur = np.radians(geometry.angle(h - k, a - k))
+    want = np.arccos(np.clip((l1**2 + l2**2 - reach**2) / (2 * l1 * l2), -1, 1))
+    bend = geometry.axis_angle(hinge, cur - want)
+    a_new = k + np.einsum("tab,tb->ta", bend, a - k)
+    turn = geometry.swing(a_new - h, goal - h)
+    upper = _path(target, thigh, shin)[:-1]
+    lower = _path(target, shin, foot)[:-1]
+    world[:, upper] = turn[:, None] @ world[:, upper]
+    world[:, lower] = (turn @ bend)[:, None] @ world[:, lower]

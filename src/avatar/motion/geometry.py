@@ -1,0 +1,83 @@
+"""Small rotation helpers on arrays of 3-vectors and 3x3 matrices (batch dimensions lead)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar.rig.skeleton import Skeleton
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    """(..., 3) vectors scaled to length 1 (zero vectors stay zero)."""
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(n, 1e-12)
+
+
+def angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(...,) angle in degrees between (..., 3) vectors (robust near 0 and 180)."""
+    a, b = unit(a), unit(b)
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, -1)))
+
+
+def swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) shortest-arc rotations taking directions a to b (both (..., 3))."""
+    a, b = np.broadcast_arrays(unit(a), unit(b))
+    axis = np.cross(a, b)
+    s = np.linalg.norm(axis, axis=-1)
+    c = np.sum(a * b, axis=-1)
+    # Opposite vectors: any perpendicular axis will do; pick one away from a.
+    other = np.where(np.abs(a[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    flip = unit(np.cross(a, other))
+    axis = np.where((s < 1e-9)[..., None] & (c < 0)[..., None], flip, unit(axis))
+    theta = np.arctan2(s, c)
+    return axis_angle(axis, theta)
+
+
+def axis_angle(axis: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """(..., 3) unit axes and (...,) radians -> (..., 3, 3) rotations (Rodrigues)."""
+    k = np.zeros(axis.shape[:-1] + (3, 3))
+    k[..., 0, 1], k[..., 0, 2] = -axis[..., 2], axis[..., 1]
+    k[..., 1, 0], k[..., 1, 2] = axis[..., 2], -axis[..., 0]
+    k[..., 2, 0], k[..., 2, 1] = -axis[..., 1], axis[..., 0]
+    s, c = np.sin(theta)[..., None, None], np.cos(theta)[..., None, None]
+    return np.eye(3) + s * k + (1 - c) * (k @ k)
+
+
+def frame(primary: np.ndarray, secondary: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) orthonormal frames, columns (x, y, z): y along ``primary``, x toward
+    ``secondary`` (made perpendicular), z = x cross y."""
+    y = unit(primary)
+    x = unit(secondary - np.sum(secondary * y, axis=-1, keepdims=True) * y)
+    return np.stack([x, y, np.cross(x, y)], axis=-1)
+
+
+def offsets(skeleton: Skeleton) -> np.ndarray:
+    """(J, 3) each bone's head in its parent's rest frame (roots: zero)."""
+    out = np.zeros((len(skeleton.names), 3))
+    has = skeleton.parents >= 0
+    p = skeleton.parents[has]
+    delta = skeleton.heads[has] - skeleton.heads[p]
+    out[has] = np.einsum("jba,jb->ja", skeleton.rest[p, :3, :3], delta)
+    return out
+
+
+def positions(skeleton: Skeleton, world: np.ndarray, roots: dict[int, np.ndarray],
+              bones: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """(T, J, 3) bone heads from world bone rotations (T, J, 3, 3).
+
+    roots: bone index -> (T, 3) head positions of bones placed directly (translated bones);
+    other parentless bones stay at their rest heads.
+    bones: (J,) bool of the bones to evaluate (closed under parents); others are NaN.
+    """
+    off = offsets(skeleton)
+    out = np.full(world.shape[:-2] + (3,), np.nan)
+    for j, p in enumerate(skeleton.parents):
+        if bones is not None and not bones[j]:
+            continue
+        if j in roots:
+            out[:, j] = roots[j]
+        elif p < 0:
+            out[:, j] = skeleton.heads[j]
+        else:
+            out[:, j] = out[:, p] + world[:, p] @ off[j]
+    return out

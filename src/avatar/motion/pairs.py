@@ -1,0 +1,95 @@
+"""Bone pairs between a source and a target skeleton, and the segments they measure."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar.motion import bonemap
+from avatar.motion.bonemap import BoneMap
+from avatar.rig.skeleton import Skeleton
+
+TRUNK = ("hips", "spine", "chest", "neck", "head")
+_MIN_SEGMENT = 1e-3  # metres; shorter segments (CMU's zero offsets) are followed further
+
+
+@dataclass(frozen=True)
+class Pair:
+    """One source bone driving one target bone.
+
+    role: canonical name, or "=name" for bones matched by identical names.
+    source, target: bone indices. source_end, target_end: index of the bone whose head ends
+    the measured segment, or -1 for the bone's own tail.
+    """
+
+    role: str
+    source: int
+    target: int
+    source_end: int
+    target_end: int
+
+    @property
+    def kind(self) -> str:
+        base = self.role.split(".")[0].rstrip("123")
+        return "trunk" if base in TRUNK else base
+
+
+def _end_role(source: Skeleton, smap: BoneMap, target: Skeleton, tmap: BoneMap, role: str):
+    """The canonical bone whose head ends ``role``'s segment on both sides: the next one
+    mapped on both, skipping any that starts where ``role`` starts on either side (CMU's
+    zero offsets); None means each bone's own tail."""
+    nxt, skipped = bonemap.NEXT.get(role), None
+    while nxt is not None and nxt in smap.bones and nxt in tmap.bones:
+        gaps = [np.linalg.norm(sk.heads[m.bones[nxt]] - sk.heads[m.bones[role]])
+                for sk, m in ((source, smap), (target, tmap))]  # fmt: skip
+        if min(gaps) > _MIN_SEGMENT:
+            return nxt
+        skipped, nxt = nxt, bonemap.NEXT.get(nxt)
+    return None if skipped is None else ("tail", skipped)
+
+
+def _end_index(bmap: BoneMap, end) -> int:
+    """Encode an end role: head of bone b -> b; tail of bone b -> -2 - b; own tail -> -1."""
+    if end is None:
+        return -1
+    if isinstance(end, tuple):
+        return -2 - bmap.bones[end[1]]
+    return bmap.bones[end]
+
+
+def make_pairs(
+    source: Skeleton, smap: BoneMap, target: Skeleton, tmap: BoneMap, match_names: bool = True
+) -> list[Pair]:
+    """Canonical pairs (roles mapped on both sides), then same-named leftovers."""
+    pairs = []
+    for role in bonemap.NEXT:
+        if role in smap.bones and role in tmap.bones:
+            end = _end_role(source, smap, target, tmap, role)
+            s_end, t_end = _end_index(smap, end), _end_index(tmap, end)
+            pairs.append(Pair(role, smap.bones[role], tmap.bones[role], s_end, t_end))
+    if match_names:
+        used_s = {p.source for p in pairs}
+        used_t = {p.target for p in pairs}
+        index = {bonemap.normalise(n): j for j, n in enumerate(source.names)}
+        for t, name in enumerate(target.names):
+            s = index.get(bonemap.normalise(name))
+            if s is not None and s not in used_s and t not in used_t:
+                pairs.append(Pair("=" + name, s, t, -1, -1))
+    return pairs
+
+
+def segment_world(skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, bone: int, end: int):
+    """(T, 3) world segment vectors of a bone: to ``end``'s head, its own tail (-1), or the
+    tail of bone ``-2 - end`` (a bone starting where this one does)."""
+    if end >= 0:
+        return pos[:, end] - pos[:, bone]
+    other = bone if end == -1 else -2 - end
+    local = skeleton.rest[other, :3, :3].T @ (skeleton.tails[other] - skeleton.heads[other])
+    return pos[:, other] - pos[:, bone] + rot[:, other] @ local
+
+
+def segment_rest(skeleton: Skeleton, bone: int, end: int) -> np.ndarray:
+    """(3,) the segment in the bone's own rest frame."""
+    far = skeleton.heads[end] if end >= 0 else skeleton.tails[bone if end == -1 else -2 - end]
+    return skeleton.rest[bone, :3, :3].T @ (far - skeleton.heads[bone])
