@@ -1,0 +1,95 @@
+"""Command-line plumbing for motion: ``avatar retarget`` (batch) and ``create --motion``.
+
+The top-level ``avatar`` command wires these in:
+
+    sub = subparsers.add_parser("retarget", help="retarget BVH clips onto an Avatar rig")
+    add_retarget_arguments(sub); sub.set_defaults(func=cli_retarget)
+    add_motion_arguments(create_parser)  # --motion --frames --fps --in-place
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from avatar.errors import ParameterError
+from avatar.io import bvh
+from avatar.motion import timing
+from avatar.motion.retarget import RetargetReport, retarget
+from avatar.rig.skeleton import Animation, Skeleton
+
+
+def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options shared by ``create --motion`` and ``retarget``."""
+    parser.add_argument("--frames", metavar="A:B", help="source frames to keep (B exclusive)")
+    parser.add_argument("--fps", type=float, help="output frame rate (default: the clip's)")
+    parser.add_argument("--in-place", action="store_true", help="remove horizontal root motion")
+    parser.add_argument("--no-foot-fix", action="store_true", help="skip contact planting (IK)")
+    parser.add_argument("--source-map", default="auto", metavar="NAME|FILE.json",
+                        help="source bone map: convention name or JSON file")  # fmt: skip
+
+
+def add_retarget_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``avatar retarget``."""
+    parser.add_argument("clips", nargs="+", help="BVH files or folders of them")
+    parser.add_argument("--rig", default="default", help="Avatar rig to retarget onto")
+    parser.add_argument("--out", default="retargeted", help="output folder (BVH per clip)")
+    parser.add_argument("--report", metavar="FILE.json", help="write per-clip quality as JSON")
+    add_motion_arguments(parser)
+
+
+def clip_paths(inputs: list[str]) -> list[Path]:
+    """Files as given, folders expanded to their ``*.bvh`` files (sorted, recursive)."""
+    out: list[Path] = []
+    for item in inputs:
+        path = Path(item)
+        if path.is_dir():
+            out.extend(sorted(path.rglob("*.bvh")))
+        elif path.exists():
+            out.append(path)
+        else:
+            raise ParameterError(f"no such clip or folder: {item}")
+    return out
+
+
+def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
+               ) -> tuple[Animation, RetargetReport]:  # fmt: skip
+    """Retarget one clip onto ``target`` with the options of ``add_motion_arguments``."""
+    source, animation = bvh.load(clip)
+    return retarget(
+        source,
+        animation,
+        target,
+        source_map=getattr(args, "source_map", "auto"),
+        frames=timing.parse_frames(getattr(args, "frames", None)),
+        fps=getattr(args, "fps", None),
+        in_place=bool(getattr(args, "in_place", False)),
+        fix_feet=not getattr(args, "no_foot_fix", False),
+    )
+
+
+def cli_retarget(args: argparse.Namespace) -> int:
+    """``avatar retarget``: every clip onto one rig, a BVH per clip plus a quality line."""
+    from avatar.human import Human
+
+    target = Human(rig=args.rig).skeleton
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    table = {}
+    for clip in clip_paths(args.clips):
+        animation, report = motion_for(target, clip, args)
+        bvh.save(out / clip.name, target, animation)
+        print(f"{clip.name}: {report.summary()}")
+        table[str(clip)] = _row(report)
+    if args.report:
+        Path(args.report).write_text(json.dumps(table, indent=1) + "\n", encoding="utf-8")
+    return 0
+
+
+def _row(report: RetargetReport) -> dict:
+    row = {"source": report.source_convention, "frames": report.frames, "fps": report.fps,
+           "scale": report.scale}  # fmt: skip
+    if report.quality is not None:
+        row.update(report.quality.as_dict())
+    return row
