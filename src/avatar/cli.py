@@ -6,7 +6,6 @@ import argparse
 import logging
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 
 from avatar.errors import AvatarError, ParameterError
 
@@ -94,9 +93,9 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--motion", metavar="CLIP.bvh", help="BVH clip to retarget onto the human, or: walk"
     )
-    p.add_argument("--frames", metavar="A:B", help="frame range of the motion (Python slice)")
-    p.add_argument("--fps", type=float, help="resample the motion to this frame rate")
-    p.add_argument("--in-place", action="store_true", help="remove the motion's root travel")
+    from avatar.motion.cli import add_motion_arguments
+
+    add_motion_arguments(p)
     p.add_argument(
         "--expressions",
         action="store_true",
@@ -119,18 +118,19 @@ def _add_info(sub: argparse._SubParsersAction) -> None:
 
 
 def _add_optional(sub: argparse._SubParsersAction) -> None:
-    """Subcommands owned by other packages (clothes, motion), added when present."""
+    """Subcommands of the clothes and motion packages."""
+    from avatar.motion.cli import add_retarget_arguments, cli_retarget
+
+    p = sub.add_parser("retarget", help="retarget BVH clips (files or folders) onto an Avatar rig",
+                       description="Retarget BVH motion capture from any common skeleton onto "
+                       "an Avatar rig; writes one BVH per clip and reports quality.")  # fmt: skip
+    add_retarget_arguments(p)
+    p.set_defaults(run=cli_retarget)
     try:
         from avatar.clothes.library import add_cli as add_clothes
-    except ImportError:
-        add_clothes = None
-    try:
-        from avatar.motion.cli import add_cli as add_motion
-    except ImportError:
-        add_motion = None
-    for add in (add_clothes, add_motion):
-        if add is not None:
-            add(sub)
+    except ImportError:  # the clothes library is optional until it lands
+        return
+    add_clothes(sub)
 
 
 def parse_assignments(items: Sequence[str]) -> dict[str, float]:
@@ -191,15 +191,16 @@ def _animation(human, args: argparse.Namespace):
 
     if args.motion in MOTIONS:
         return MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0)
-    if args.motion:
-        from avatar.motion.cli import motion_for_human
+    clip = args.motion or (args.pose if args.pose and args.pose.lower().endswith(".bvh") else None)
+    if clip:
+        from avatar.motion.cli import motion_for
 
-        return motion_for_human(human, args.motion, args.frames, args.fps, args.in_place)
+        if not args.motion:  # a BVH pose: its first frame
+            args = argparse.Namespace(**{**vars(args), "frames": "0:1"})
+        animation, report = motion_for(human.skeleton, clip, args)
+        log.info("%s", report.summary())
+        return animation
     if args.pose:
-        if Path(args.pose).suffix.lower() == ".bvh":
-            from avatar.motion.cli import motion_for_human
-
-            return motion_for_human(human, args.pose, "0:1", None, True)
         return human.pose(args.pose)
     return None
 

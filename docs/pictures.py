@@ -1,0 +1,42 @@
+"""Render the README's pictures: `.venv/bin/python docs/pictures.py [bodies]`.
+
+Writes docs/images/bodies.png (a row of bodies across the parameter space).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-blender-"))
+
+from avatar.blender import render, scene  # noqa: E402
+from avatar.body.model import BodyModel  # noqa: E402
+from avatar.human import Human  # noqa: E402
+
+IMAGES = Path(__file__).parent / "images"
+BODIES = {
+    "child": {"age": 0.12, "gender": 0.4, "caucasian": 1.0},
+    "old man": {"age": 1.0, "gender": 1.0, "weight": 0.65, "african": 1.0},
+    "muscular woman": {"gender": 0.0, "muscle": 1.0, "weight": 0.55, "asian": 1.0},
+    "default": {},
+    "heavy, belly +2.5": {"gender": 0.7, "weight": 1.0, "pca/belly": 2.5},
+    "thin, tall": {"gender": 0.2, "weight": 0.0, "height": 0.9, "pca/limbs_fat": -2},
+    "hips fat +3": {"gender": 0.0, "pca/hips_fat": 3.0, "pca/breast": 2.0},
+}
+
+
+def bodies() -> Path:
+    model = BodyModel.load()
+    chars = [
+        scene.character_from_human(Human(p, model=model), name=n) for n, p in BODIES.items()
+    ]
+    return render.render_grid(chars, IMAGES / "bodies.png", spacing=0.9,
+                              resolution=(1800, 700), samples=48)  # fmt: skip
+
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or ["bodies"]:
+        print(globals()[name]())
