@@ -58,7 +58,7 @@ class AVATAR_OT_create_human(bpy.types.Operator):
 
         def create():
             built = _character().create(recipe, location=location)
-            context.view_layer.objects.active = built.root
+            _select(context, built)
             return f"Created {built.root.name}"
 
         return _call(self, create)
@@ -206,8 +206,17 @@ class AVATAR_OT_apply_motion(bpy.types.Operator):
 def _rebuild(context, obj, recipe, verb):
     """Rebuild ``obj``'s character from ``recipe``, keep it active; a one-line report."""
     built = _character().update(obj, recipe)
-    context.view_layer.objects.active = built.root
+    _select(context, built)
     return f"{verb} {built.root.name}"
+
+
+def _select(context, built):
+    """Make the new character the selection, its root active (as Blender's Add menu does)."""
+    for obj in context.view_layer.objects:
+        obj.select_set(False)
+    for obj in (built.root, *built.parts):
+        obj.select_set(True)
+    context.view_layer.objects.active = built.root
 
 
 def _stored_recipe(context):

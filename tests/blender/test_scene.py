@@ -58,3 +58,19 @@ def test_camera_sees_every_character(empty_scene, rng):
         for corner in obj.bound_box:
             x, y, depth = world_to_camera_view(sc, cam, obj.matrix_world @ Vector(corner))
             assert 0 <= x <= 1 and 0 <= y <= 1 and depth > 0
+
+
+def test_failed_build_adds_nothing(empty_scene, rng):
+    import bpy
+    import pytest
+
+    from avatar.blender import scene
+    from avatar.part import MeshPart
+
+    good = MeshPart("ok", box_mesh((0, 0, 0), (1, 1, 1)))
+    bad = MeshPart(
+        "bad", box_mesh((0, 0, 0), (1, 1, 1)), skin=(np.full((8, 1), 99), np.ones((8, 1)))
+    )
+    with pytest.raises(IndexError):
+        scene.build_character(scene.Character("broken", [good, bad], skeleton(rng)))
+    assert len(bpy.data.objects) == 0 and "broken" not in bpy.data.collections

@@ -98,10 +98,12 @@ def _multiply_colour(tree, colour_socket, factor) -> bpy.types.NodeSocket:
         return colour_socket
     mix = tree.nodes.new("ShaderNodeMix")
     mix.data_type, mix.blend_type, mix.location = "RGBA", "MULTIPLY", (-350, 300)
-    mix.inputs["Factor"].default_value = 1.0
-    tree.links.new(colour_socket, mix.inputs["A"])
-    mix.inputs["B"].default_value = (*[float(c) for c in factor[:3]], 1.0)
-    return mix.outputs["Result"]
+    # The Mix node has float, vector and colour sockets of the same names: pick by identifier.
+    inputs = {s.identifier: s for s in mix.inputs}
+    inputs["Factor_Float"].default_value = 1.0
+    tree.links.new(colour_socket, inputs["A_Color"])
+    inputs["B_Color"].default_value = (*[float(c) for c in factor[:3]], 1.0)
+    return next(s for s in mix.outputs if s.identifier == "Result_Color")
 
 
 def _mean_colour(image: np.ndarray) -> tuple[float, float, float]:

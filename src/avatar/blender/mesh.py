@@ -33,8 +33,15 @@ def mesh_data(name: str, mesh: Mesh) -> bpy.types.Mesh:
     data.update(calc_edges=True)
     if mesh.uvs is not None and mesh.face_uvs is not None:
         _set_uvs(data, mesh.uvs[np.asarray(mesh.face_uvs).ravel()])
-    data.shade_smooth()
+    _shade_smooth(data)
     return data
+
+
+def _shade_smooth(data: bpy.types.Mesh) -> None:
+    if hasattr(data, "shade_smooth"):  # Blender 4.1+
+        data.shade_smooth()
+    else:
+        data.polygons.foreach_set("use_smooth", np.ones(len(data.polygons), dtype=bool))
 
 
 def _set_uvs(data: bpy.types.Mesh, corner_uvs: np.ndarray) -> None:
@@ -96,6 +103,8 @@ def set_shape_keys(obj: bpy.types.Object, offsets: Mapping[str, np.ndarray]) -> 
 
 def set_normals(obj: bpy.types.Object, normals: np.ndarray) -> None:
     """Custom per-vertex normals (V, 3) (e.g. the body's, so seams between parts match)."""
+    if bpy.app.version < (4, 1):  # older Blenders ignore custom normals without auto smooth
+        obj.data.use_auto_smooth = True
     obj.data.normals_split_custom_set_from_vertices(np.asarray(normals, np.float32))
 
 

@@ -7,6 +7,7 @@ does not depend on how the core assembles a human; ``character_from_human`` adap
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -55,8 +56,25 @@ class CharacterObjects:
 def build_character(
     character: Character, collection: bpy.types.Collection | None = None
 ) -> CharacterObjects:
-    """Create a character's objects: armature, skinned parts with materials, action."""
+    """Create a character's objects: armature, skinned parts with materials, action.
+
+    All or nothing: if any step fails, what was already added is removed and the error
+    propagates.
+    """
+    before = set(bpy.data.objects)
+    made_collection = collection is None
     collection = collection or new_collection(character.name)
+    try:
+        return _build(character, collection)
+    except Exception:
+        for obj in set(bpy.data.objects) - before:
+            bpy.data.objects.remove(obj)
+        if made_collection:
+            bpy.data.collections.remove(collection)
+        raise
+
+
+def _build(character: Character, collection: bpy.types.Collection) -> CharacterObjects:
     armature = None
     if character.skeleton is not None:
         armature = armature_bridge.new_armature_object(
@@ -69,8 +87,6 @@ def build_character(
     if armature is not None and character.animation is not None:
         action_bridge.apply_animation(armature, character.animation, f"{character.name} motion")
     if character.recipe is not None:
-        import json
-
         root["avatar_recipe"] = json.dumps(character.recipe)
     return CharacterObjects(root, armature, parts)
 
