@@ -62,10 +62,14 @@ class AvatarSettings(bpy.types.PropertyGroup):
         "garments": CollectionProperty(type=AvatarGarment),
         "garment_index": IntProperty(default=0),
         "bvh_path": StringProperty(name="BVH", subtype="FILE_PATH"),
-        "frame_start": IntProperty(name="First", min=0, default=0,
-                                   description="First source frame (0 = start of clip)"),
-        "frame_end": IntProperty(name="Last", min=0, default=0,
-                                 description="Last source frame (0 = end of clip)"),
+        "frame_start": IntProperty(
+            name="Start", min=0, default=0,
+            description="First source frame, 0-based (as the CLI's --frames A:B)",
+        ),
+        "frame_end": IntProperty(
+            name="Stop", min=0, default=0,
+            description="Source frame to stop before (0 = to the end of the clip)",
+        ),
         "fps": FloatProperty(name="FPS", min=0.0, default=0.0,
                              description="Resample to this rate (0 = the clip's own)"),
         "in_place": BoolProperty(name="In place", default=False),
@@ -105,7 +109,7 @@ class AvatarSettings(bpy.types.PropertyGroup):
         """The Motion panel as the spec ``avatar.blender.character`` takes."""
         frames = None
         if self.frame_start or self.frame_end:
-            frames = [self.frame_start, self.frame_end or None]
+            frames = [self.frame_start, self.frame_end or None]  # a Python slice, A:B
         return {"path": bpy.path.abspath(self.bvh_path), "frames": frames,
                 "fps": self.fps or None, "in_place": self.in_place}  # fmt: skip
 

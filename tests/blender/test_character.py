@@ -75,18 +75,19 @@ def test_motion_is_applied_and_survives_update(empty_scene, fake_library, monkey
     character = fake_library
     calls = []
 
-    def retarget_file(path, skel, frames, fps, in_place):
-        calls.append((path, frames, fps, in_place))
-        return random_animation(skel, np.random.default_rng(2), frames=6)
+    def retarget(source, clip, target, frames, fps, in_place):
+        calls.append((clip, frames, fps, in_place))
+        return random_animation(target, np.random.default_rng(2), frames=6), None
 
-    monkeypatch.setattr(avatar.motion, "retarget_file", retarget_file, raising=False)
+    monkeypatch.setattr(avatar.motion, "load_bvh", lambda path: (None, path))
+    monkeypatch.setattr(avatar.motion, "retarget", retarget)
     built = character.create({"params": {}})
-    spec = {"path": "walk.bvh", "frames": [1, 6], "fps": 30, "in_place": False}
+    spec = {"path": "walk.bvh", "frames": [1, 7], "fps": 30, "in_place": False}
     assert "6 frames" in character.apply_motion(built.parts[0], spec)
     again = character.update(built.root, {"params": {"height": 0.9}})
     assert again.root.animation_data.action is not None
     assert json.loads(again.root["avatar_motion"]) == spec
-    assert calls[-1] == ("walk.bvh", (1, 6), 30, False)
+    assert calls[-1] == ("walk.bvh", slice(1, 7), 30, False)
 
 
 def test_not_a_character(empty_scene):

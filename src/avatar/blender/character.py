@@ -79,7 +79,7 @@ def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.Charact
 def apply_motion(obj: bpy.types.Object, motion: Mapping[str, object]) -> str:
     """Retarget a BVH clip onto the character ``obj`` belongs to and assign it as its action.
 
-    motion: {"path": BVH file, "frames": [first, last] source frames or None,
+    motion: {"path": BVH file, "frames": [start, stop] (see ``load_motion``) or None,
     "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
     updates re-apply it. Returns a one-line summary.
     """
@@ -97,21 +97,24 @@ def apply_motion(obj: bpy.types.Object, motion: Mapping[str, object]) -> str:
 
 
 def load_motion(motion: Mapping[str, object], skeleton) -> object:
-    """The Animation of a Motion-panel spec, retargeted onto ``skeleton``."""
-    from avatar.errors import AvatarError
+    """The Animation of a Motion-panel spec, retargeted onto ``skeleton``.
 
-    try:
-        from avatar.motion import retarget_file
-    except ImportError as exc:
-        raise AvatarError("BVH retargeting is not available in this avatar build") from exc
+    motion["frames"]: [start, stop] source frames as the CLI's ``--frames A:B`` (0-based,
+    stop exclusive, None = to the end), or None for the whole clip.
+    """
+    from avatar import motion as library
+
     frames = motion.get("frames")
-    return retarget_file(
-        motion["path"],
+    source_skeleton, clip = library.load_bvh(motion["path"])
+    animation, _report = library.retarget(
+        source_skeleton,
+        clip,
         skeleton,
-        frames=tuple(frames) if frames else None,
+        frames=slice(*frames) if frames else None,
         fps=motion.get("fps"),
         in_place=bool(motion.get("in_place")),
     )
+    return animation
 
 
 def root_of(obj: bpy.types.Object | None) -> bpy.types.Object | None:
