@@ -1,11 +1,13 @@
 """Build and validate the Avatar Blender extension zip.
 
-    python addon/build.py [--output dist/] [--blender-ext PATH] [--no-wheel]
+    python addon/build.py [--output dist/] [--platform linux-x64] [--python 3.11] [--no-wheel]
 
 Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
-from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``
-and list it in the manifest, then run Blender's own ``blender_ext.py build`` and
-``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
+from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``,
+download the binary wheel of its one dependency Blender lacks (SciPy; Blender ships numpy,
+and pygltflib/tqdm are imported only by glTF export and the CLI) for the target platform and
+Blender's Python, list them in the manifest, then run Blender's own ``blender_ext.py build``
+and ``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
 (``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
 so no Blender binary is needed. Prints the zip's path.
 """
@@ -30,11 +32,18 @@ def main(argv: list[str] | None = None) -> Path:
     args = _parse(argv)
     version = project_version()
     stage = stage_sources(STAGE / "avatar_addon")
-    wheels = [] if args.no_wheel else [build_wheel(stage / "wheels")]
-    stamp_manifest(stage / "blender_manifest.toml", version, wheels)
+    wheels = []
+    if not args.no_wheel:
+        wheels = [
+            build_wheel(stage / "wheels"),
+            *download_binary_wheels(stage / "wheels", args.platform, args.python),
+        ]
+    platforms = [args.platform] if wheels else []
+    stamp_manifest(stage / "blender_manifest.toml", version, wheels, platforms)
     tool = args.blender_ext or find_blender_ext()
     args.output.mkdir(parents=True, exist_ok=True)
-    zip_path = args.output.resolve() / f"avatar_addon-{version}.zip"
+    suffix = f"-{args.platform}" if wheels else ""
+    zip_path = args.output.resolve() / f"avatar_addon-{version}{suffix}.zip"
     _run(tool, "build", "--source-dir", stage, "--output-filepath", zip_path)
     _run(tool, "validate", zip_path)
     print(zip_path)
@@ -45,6 +54,17 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, default=ROOT / "dist")
     parser.add_argument("--blender-ext", type=Path, help="path to blender_ext.py")
+    parser.add_argument(
+        "--platform",
+        default=host_platform(),
+        choices=sorted(PIP_PLATFORMS),
+        help="Blender platform the zip is for (default: this machine's)",
+    )
+    parser.add_argument(
+        "--python",
+        default="3.11",
+        help="Blender's Python version (3.11: Blender 4.2-5.0; 3.13: 5.1+)",
+    )
     parser.add_argument(
         "--no-wheel", action="store_true", help="leave the avatar library out (needs sys.path)"
     )
@@ -76,12 +96,45 @@ def build_wheel(folder: Path) -> Path:
     return wheels[-1]
 
 
-def stamp_manifest(manifest: Path, version: str, wheels: list[Path]) -> None:
-    """Set ``version`` and ``wheels`` (paths relative to the manifest) in place."""
+def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Path]:
+    """SciPy's binary wheel for ``platform`` and ``python``, the version installed here."""
+    from importlib.metadata import version
+
+    before = set(folder.glob("*.whl"))
+    _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
+         "--only-binary=:all:", "--python-version", python, "--platform",
+         PIP_PLATFORMS[platform], "-d", folder, f"scipy=={version('scipy')}")  # fmt: skip
+    return sorted(set(folder.glob("*.whl")) - before)
+
+
+PIP_PLATFORMS = {  # Blender platform name -> pip platform tag
+    "linux-x64": "manylinux_2_28_x86_64",  # Blender 4.2+ itself needs glibc 2.28
+    "linux-arm64": "manylinux_2_28_aarch64",
+    "windows-x64": "win_amd64",
+    "macos-arm64": "macosx_12_0_arm64",
+    "macos-x64": "macosx_10_14_x86_64",
+}
+
+
+def host_platform() -> str:
+    import platform
+
+    machine = {"x86_64": "x64", "amd64": "x64", "aarch64": "arm64", "arm64": "arm64"}
+    system = {"linux": "linux", "darwin": "macos", "windows": "windows"}
+    return f"{system[platform.system().lower()]}-{machine[platform.machine().lower()]}"
+
+
+def stamp_manifest(manifest: Path, version: str, wheels: list[Path], platforms: list[str]) -> None:
+    """Set ``version``, ``wheels`` (paths relative to the manifest) and, when wheels are
+    platform-specific, ``platforms`` in place."""
     text = manifest.read_text()
     text = re.sub(r'(?m)^version = ".*"$', f'version = "{version}"', text)
     listed = ", ".join(f'"./wheels/{w.name}"' for w in wheels)
     text = re.sub(r"(?m)^wheels = \[.*\]$", f"wheels = [{listed}]", text)
+    if platforms:
+        text = text.replace(
+            "\nwheels = ", f"\nplatforms = {platforms!r}\nwheels = ".replace("'", '"')
+        )
     manifest.write_text(text)
 
 

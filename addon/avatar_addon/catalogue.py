@@ -25,11 +25,10 @@ def local_targets() -> tuple[str, ...]:
         return ()
 
 
-def garments() -> list[tuple[str, str]]:
-    """(name, category) of every garment in the clothes library."""
-    try:
-        from avatar.clothes import library
-    except ImportError as exc:
-        log.warning("Avatar: no clothes library (%s)", exc)
-        return []
-    return [(g.name, getattr(g, "category", "")) for g in library.catalogue()]
+def garments() -> list[tuple[str, str, str]]:
+    """(name, category, recipe entry) of every garment in the clothes library; the entry is
+    the name of a built-in garment or the ``.mhclo`` path of a user's."""
+    from avatar.clothes.library import list_garments
+
+    return [(e.name, e.category, e.name if e.source == "builtin" else e.source)
+            for e in list_garments()]  # fmt: skip

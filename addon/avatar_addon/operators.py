@@ -139,13 +139,15 @@ class AVATAR_OT_refresh_library(bpy.types.Operator):
     bl_label = "Refresh"
 
     def execute(self, context):
-        items = context.scene.avatar.garments
-        items.clear()
-        for name, category in catalogue.garments():
-            item = items.add()
-            item.name, item.category = name, category
-        self.report({"INFO"}, f"{len(items)} garments")
-        return {"FINISHED"}
+        def refresh():
+            items = context.scene.avatar.garments
+            items.clear()
+            for name, category, entry in catalogue.garments():
+                item = items.add()
+                item.name, item.category, item.entry = name, category, entry
+            return f"{len(items)} garments"
+
+        return _call(self, refresh)
 
 
 class _DressOperator:
@@ -161,7 +163,7 @@ class _DressOperator:
 
     def execute(self, context):
         settings = context.scene.avatar
-        garment = settings.garments[settings.garment_index].name
+        garment = settings.garments[settings.garment_index].entry
         recipe = _stored_recipe(context)
         clothes = [c for c in recipe.get("clothes") or [] if c != garment]
         recipe["clothes"] = clothes + [garment] if self.wear else clothes

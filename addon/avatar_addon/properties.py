@@ -43,6 +43,7 @@ class AvatarGarment(bpy.types.PropertyGroup):
 
     name: StringProperty(name="Garment")
     category: StringProperty(name="Category")
+    entry: StringProperty(name="Recipe entry", description="Built-in name or .mhclo path")
 
 
 def _search_targets(self, context, text: str):

@@ -93,3 +93,12 @@ class _Fake:
 
     def to_recipe(self):
         return self._recipe
+
+
+def test_dress_library_lists_the_builtin_garments(installed):
+    import bpy
+
+    assert bpy.ops.avatar.refresh_library() == {"FINISHED"}
+    garments = bpy.context.scene.avatar.garments
+    assert len(garments) >= 14
+    assert all(g.entry for g in garments)
