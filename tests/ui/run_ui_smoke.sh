@@ -77,8 +77,12 @@ xdotool mousemove $((LEFT + WIDTH + TAB_DX)) $((TOP + TAB_DY)) click 1   # the A
 sleep 1
 shot before-create
 xdotool mousemove $((LEFT + CREATE_DX)) $((TOP + CREATE_DY)) click 1     # Create
-sleep "${AVATAR_UI_WAIT:-15}"                  # first use compiles/loads the body model
-shot after-create
+# The first Create loads (or compiles) the body model: poll until a character shows up.
+for _ in $(seq "${AVATAR_UI_WAIT:-30}"); do
+  sleep 3
+  shot after-create
+  grep -q '"characters": {}' "$OUT/state.json" || break
+done
 : > "$OUT/request-quit"
 wait "$BLENDER_PID" || true
 BLENDER_PID=""
