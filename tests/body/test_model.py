@@ -142,3 +142,23 @@ def test_attributes_agree_with_the_2020_addon_basis(model, fixtures):
         assert a @ b / np.linalg.norm(a) / np.linalg.norm(b) > 0.9, name
     body = theirs.body({"breast": 1.0})
     assert body.shape == (13380, 3) and np.isfinite(body).all()
+
+
+def test_memoised_macro_sums_match_full_sums(model):
+    """Dragging one macro group (contraction), local edits (memo) and jumps give full sums."""
+    from avatar.body.model import GROUP_LEVELS, MACRO_GROUP
+
+    levels = set(model.macro_table.level_names) - {"universal"}
+    assert levels <= {lv for group in GROUP_LEVELS.values() for lv in group}  # no middle files
+    rng = np.random.default_rng(7)
+    values = {k: rng.uniform() for k in macros.MACROS}
+    for group in [*GROUP_LEVELS, "age", "gender", "age"]:  # also alternate and come back
+        for step, v in enumerate([0.0, rng.uniform(), 1.0, rng.uniform()]):
+            values |= {m: v for m in macros.MACROS if MACRO_GROUP[m] == group}
+            got = model.macro_sum(values)
+            np.testing.assert_allclose(got, model.macro_sum.full(values), atol=1e-6)
+            got[:] = 0.0  # results are fresh arrays: mutating one must not leak into the next
+            if step == 1:  # a local edit reuses the memo and gives the same body twice
+                edit = values | {"torso/torso-scale-depth-decr|incr": 0.5}
+                np.testing.assert_array_equal(model.shape(edit), model.shape(edit))
+        assert model.macro_sum._contraction.group == group  # the drag used a contraction
