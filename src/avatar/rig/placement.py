@@ -69,7 +69,7 @@ class RigDefinition:
 
     def joint_positions(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Heads (J, 3) and tails (J, 3) on ``vertices`` (V, 3) or a batch (..., V, 3)."""
-        v = np.asarray(vertices, dtype=np.float64)[..., self.vertex, :]  # (..., 2J, P, 3)
+        v = np.asarray(vertices)[..., self.vertex, :].astype(np.float64)  # (..., 2J, P, 3)
         ends = np.sum(v * self._weights, axis=-2) + self.offsets
         j = len(self.names)
         return ends[..., :j, :], ends[..., j:, :]
