@@ -32,6 +32,6 @@ fi
 # The Khronos glTF validator, for tests; optional when npm is absent.
 if command -v npm >/dev/null && [ ! -d .cache/node/node_modules/gltf-validator ]; then
   mkdir -p .cache/node
-  npm install --silent --prefix .cache/node gltf-validator@2 >/dev/null 2>&1 \
+  npm install --silent --prefix .cache/node gltf-validator@2.0.0-dev.3.10 >/dev/null 2>&1 \
     || echo "setup: gltf-validator could not be installed; its tests will skip" >&2
 fi
