@@ -9,8 +9,9 @@ setup:
 	@bash scripts/setup.sh
 
 demo: setup
-	$(VENV)/avatar create --set gender=0.3 --set age=0.45 --set muscle=0.6 --pose t-pose \
-		-o $(OUT)/demo.glb --render $(OUT)/demo.png
+	$(VENV)/avatar create --set gender=0.3 --set age=0.45 --set muscle=0.6 \
+		--wear tshirt --wear jeans --wear shoes --wear hair-short --wear eyebrows --wear eyelashes \
+		--motion walk -o $(OUT)/demo.glb --render $(OUT)/demo.png
 	@echo "wrote $(OUT)/demo.glb and $(OUT)/demo.png"
 
 test: setup

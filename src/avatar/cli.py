@@ -126,11 +126,16 @@ def _add_optional(sub: argparse._SubParsersAction) -> None:
                        "an Avatar rig; writes one BVH per clip and reports quality.")  # fmt: skip
     add_retarget_arguments(p)
     p.set_defaults(run=cli_retarget)
-    try:
-        from avatar.clothes.library import add_cli as add_clothes
-    except ImportError:  # the clothes library is optional until it lands
-        return
-    add_clothes(sub)
+    from avatar.clothes.library import cli_clothes_list
+
+    clothes = sub.add_parser("clothes", help="the clothes library",
+                             description="List and search the clothes library.")  # fmt: skip
+    clothes_sub = clothes.add_subparsers(title="commands", metavar="COMMAND")
+    p = clothes_sub.add_parser("list", help="list garments (built-in and user folders)")
+    p.add_argument("--search", metavar="TEXT", help="only garments matching every word")
+    p.add_argument("--folder", action="append", metavar="DIR",
+                   help="also scan this MakeHuman/MPFB asset folder; repeatable")  # fmt: skip
+    p.set_defaults(run=cli_clothes_list)
 
 
 def parse_assignments(items: Sequence[str]) -> dict[str, float]:
@@ -181,9 +186,11 @@ def run_create(args: argparse.Namespace) -> int:
 def _dress(human, wear: list[str]):
     if not wear:
         return human
-    from avatar.clothes.library import dress_human
+    from avatar.clothes import library
 
-    return dress_human(human, wear)
+    for name in wear:  # fail early, naming the unknown garment, before any fitting
+        library.load_garment(name)
+    return human.dressed(*wear)
 
 
 def _animation(human, args: argparse.Namespace):

@@ -1,7 +1,7 @@
 """The composition root: a serialisable recipe and the human it realises.
 
-    human = Human({"gender": 1.0, "age": 0.4, "pca/belly": 1.5}, rig="game_engine")
-    human.mesh, human.skeleton, human.weights, human.posed(animation)
+human = Human({"gender": 1.0, "age": 0.4, "pca/belly": 1.5}, rig="game_engine")
+human.mesh, human.skeleton, human.weights, human.posed(animation)
 """
 
 from __future__ import annotations
@@ -77,7 +77,9 @@ class Human:
         self.recipe = replace(recipe or Recipe(), params=values, rig=rig)
 
     @classmethod
-    def from_recipe(cls, recipe: Recipe | Mapping[str, Any], model: BodyModel | None = None) -> Human:
+    def from_recipe(
+        cls, recipe: Recipe | Mapping[str, Any], model: BodyModel | None = None
+    ) -> Human:
         r = recipe if isinstance(recipe, Recipe) else Recipe.from_dict(recipe)
         return cls(r.params, r.rig, model, r)
 
@@ -140,7 +142,9 @@ class Human:
 
     def pose(self, name: str) -> Animation:
         """A named pose ("rest", "a-pose", "t-pose") for this rig."""
-        return poses.named_pose(self.skeleton, self.recipe.rig, name, self.model.assets.meta["poses"])
+        return poses.named_pose(
+            self.skeleton, self.recipe.rig, name, self.model.assets.meta["poses"]
+        )
 
     def posed(
         self, animation: Animation, frames: slice | None = None, method: str = "lbs"
@@ -169,9 +173,28 @@ class Human:
         out = []
         for name in BODY_PART_GROUPS:
             morphs = self.expression_morphs() if expressions and name == "body" else {}
-            part = MeshPart(name, self.part(name), self.material(name), self.part_skin(name), morphs)
+            part = MeshPart(
+                name, self.part(name), self.material(name), self.part_skin(name), morphs
+            )
             out.append(part)
+        if self.recipe.clothes:
+            from avatar.clothes import library
+
+            out += library.parts(self.outfit)
         return out
+
+    @cached_property
+    def outfit(self):
+        """The recipe's garments fitted on this body (``avatar.clothes.fitting.Outfit``)."""
+        from avatar.clothes import library
+
+        return library.dress(self, list(self.recipe.clothes))
+
+    def dressed(self, *garments: str) -> Human:
+        """A copy of this human also wearing ``garments`` (library names or .mhclo paths)."""
+        clothes = tuple(dict.fromkeys(self.recipe.clothes + tuple(str(g) for g in garments)))
+        return Human(self.recipe.params, self.recipe.rig, self.model,
+                     replace(self.recipe, clothes=clothes))  # fmt: skip
 
     def expression_morphs(self) -> dict[str, np.ndarray]:
         """ARKit face unit name -> (13380, 3) float32 body-vertex deltas (metres)."""
@@ -196,9 +219,7 @@ class Human:
 
     # ------------------------------------------------------------------ MakeHuman files
     @classmethod
-    def from_mhm(
-        cls, path: str, model: BodyModel | None = None, rig: str | None = None
-    ) -> Human:
+    def from_mhm(cls, path: str, model: BodyModel | None = None, rig: str | None = None) -> Human:
         """A human from a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes)."""
         from avatar.io import mhm
 

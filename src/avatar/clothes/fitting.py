@@ -111,18 +111,20 @@ class Pose:
             self.vertices, self.surface, points, k=k, tree=self.tree, normals=self.normals
         )
 
-    def resolve(self, points: np.ndarray, garment: Garment, iterations: int = 2):
+    def resolve(self, points: np.ndarray, garment: Garment, iterations: int = 6):
         """Push a garment's bound surface (N, 3) out of the body and the layers below.
 
         Returns (points (N, 3) float32, query at the final positions).
         """
-        q = self.query(points)
+        # k=4 candidate rings: one nearest vertex can miss the closest triangle where the
+        # body folds (armpits, crotch), leaving points inside that a finer query finds.
+        q = self.query(points, k=4)
         for _ in range(iterations):
             need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
             if np.all(q.distance >= need - 1e-5):
                 break
             points = collision.push_out(points, q, need)
-            q = self.query(points)
+            q = self.query(points, k=4)
         self._raise_floor(q, garment.thickness)
         return points, q
 
@@ -177,6 +179,16 @@ class Outfit:
     surface: collision.BodySurface
     rest_surfaces: list[np.ndarray]  # (N, 3) resolved bound surface per garment
     surface_weights: list[SkinWeights]
+
+    # An Outfit reads as the list of its FittedGarments.
+    def __iter__(self):
+        return iter(self.garments)
+
+    def __len__(self) -> int:
+        return len(self.garments)
+
+    def __getitem__(self, i: int) -> FittedGarment:
+        return self.garments[i]
 
     def frame(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
         """Garment vertices (M_i, 3) for one posed frame.

@@ -1,0 +1,171 @@
+"""The body built-in garments are modelled on, and the geometry tools they are cut with.
+
+The authoring body is the default human (all macros 0.5). Garments are cut from its
+``helper-tights`` and ``helper-skirt`` shells (which MakeHuman's targets reshape for every
+body) or from its skin, eased outward along the skin normal, given their own UVs, and then
+bound with ``binder.bind`` to the surface they came from, so they follow every shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from avatar.clothes import regions
+from avatar.clothes.binder import bind
+from avatar.clothes.binding import Binding, make_binding
+from avatar.clothes.fabrics import TILE_METRES
+from avatar.mesh import Mesh, vertex_normals
+
+SKIN = 13380
+
+
+class AuthoringBody:
+    """The default human with the derived data garment builders need."""
+
+    def __init__(self, human):
+        self.human = human
+        self.vertices = np.asarray(human.vertices, dtype=np.float64)
+        self.base: Mesh = human.model.base
+        self.marks = regions.landmarks(human.skeleton)
+        self.part = regions.part_labels(human.skeleton.names, human.weights.indices[:, 0])
+
+    @cached_property
+    def skin_faces(self) -> np.ndarray:
+        return self.base.faces[self.base.face_groups["body"]]
+
+    @cached_property
+    def skin_normals(self) -> np.ndarray:
+        return vertex_normals(self.vertices[:SKIN].astype(np.float32), self.skin_faces)
+
+    @cached_property
+    def skin_tree(self) -> cKDTree:
+        return cKDTree(self.vertices[:SKIN])
+
+    def outward(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) skin normal at the nearest skin vertex: 'away from the body' everywhere."""
+        _, i = self.skin_tree.query(points)
+        return self.skin_normals[i].astype(np.float64)
+
+    def group_faces(self, group: str) -> np.ndarray:
+        return self.base.faces[self.base.face_groups[group]]
+
+    def centre(self, group: str) -> np.ndarray:
+        return self.vertices[self.base.groups[group]].mean(axis=0)
+
+
+@dataclass(frozen=True)
+class Piece:
+    """Garment geometry on the authoring body, bound to the surface it came from."""
+
+    mesh: Mesh
+    binding: Binding
+
+
+def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease) -> Mesh:
+    """A surface of the chosen faces, pushed ``ease`` metres out along the skin normal.
+
+    faces: (F, 4) base-mesh faces of the source surface; keep: (F,) bool.
+    ease: float or callable (points (N, 3), arm (N,), leg (N,)) -> (N,) metres.
+    Returns a Mesh (own vertex numbering) with box-projected UVs; faces face outward.
+    """
+    chosen = faces[keep]
+    used, inverse = np.unique(chosen, return_inverse=True)
+    points = body.vertices[used]
+    if callable(ease):
+        arm, leg = regions.limb_coordinates(points, body.marks)
+        ease = ease(points, arm, leg)
+    points = points + np.asarray(ease)[..., None] * body.outward(points)
+    local = inverse.reshape(chosen.shape).astype(np.int32)
+    return with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+
+
+def orient_outward(body: AuthoringBody, points: np.ndarray, faces: np.ndarray) -> Mesh:
+    """Flip faces whose normal points into the body (so shells extrude the right way)."""
+    v = points[faces]
+    n = np.cross(v[:, 2] - v[:, 0], v[:, 3 % faces.shape[1]] - v[:, 1])
+    inward = np.einsum("fd,fd->f", n, body.outward(v.mean(axis=1))) < 0
+    faces = faces.copy()
+    faces[inward] = faces[inward][:, [2, 1, 0, 3]] if faces.shape[1] == 4 else faces[inward][
+        :, [0, 2, 1]
+    ]
+    return Mesh(vertices=points, faces=faces)
+
+
+def with_box_uvs(mesh: Mesh, tile: float = TILE_METRES) -> Mesh:
+    """Per-corner UVs by projecting each face on the plane its normal faces most (in tiles).
+
+    Vertical faces keep z as v, so the fabric's warp runs down the body.
+    """
+    f = mesh.faces
+    v = mesh.vertices[f].astype(np.float64)  # (F, C, 3)
+    n = np.abs(np.cross(v[:, 2] - v[:, 0], v[:, -1] - v[:, 1]))
+    axis = np.argmax(n, axis=1)[:, None]
+    u = np.where(axis == 0, v[..., 1], v[..., 0])
+    w = np.where(axis == 2, v[..., 1], v[..., 2])
+    uvs = np.stack([u, w], -1).reshape(-1, 2) / tile
+    face_uvs = np.arange(f.size, dtype=np.int32).reshape(f.shape)
+    return Mesh(mesh.vertices, f, uvs.astype(np.float32), face_uvs)
+
+
+def bound(body: AuthoringBody, mesh: Mesh, surface_faces: np.ndarray) -> Piece:
+    """Bind a mesh on the authoring body to a surface (base-mesh faces)."""
+    return Piece(mesh, bind(mesh.vertices, body.vertices, surface_faces))
+
+
+def single_references(body: AuthoringBody, group: str, uvs_from_base: bool = True) -> Piece:
+    """A helper group used as is, each vertex a single-vertex reference (MakeHuman's
+    eyelashes are bound this way), with the base mesh's UVs."""
+    fidx = body.base.face_groups[group]
+    mesh = body.base.with_vertices(body.vertices.astype(np.float32)).subset(fidx)
+    used = np.unique(body.base.faces[fidx])
+    n = len(used)
+    binding = make_binding(
+        np.repeat(used[:, None], 3, 1), np.tile([1.0, 0, 0], (n, 1)), np.zeros((n, 3)),
+        single=np.ones(n, bool),
+    )
+    return Piece(mesh, binding)
+
+
+def join(pieces: list[Piece]) -> Piece:
+    """One garment from several pieces (e.g. a dress's bodice and skirt)."""
+    meshes = [p.mesh for p in pieces]
+    offset = np.cumsum([0] + [len(m.vertices) for m in meshes])
+    uv_offset = np.cumsum([0] + [len(m.uvs) for m in meshes])
+    width = max(m.faces.shape[1] for m in meshes)
+    faces = np.concatenate([_pad(m.faces, width) + o for m, o in zip(meshes, offset, strict=False)])
+    fuv = np.concatenate(
+        [_pad(m.face_uvs, width) + o for m, o in zip(meshes, uv_offset, strict=False)]
+    )
+    mesh = Mesh(
+        np.concatenate([m.vertices for m in meshes]),
+        faces.astype(np.int32),
+        np.concatenate([m.uvs for m in meshes]),
+        fuv.astype(np.int32),
+    )
+    b = [p.binding for p in pieces]
+    binding = make_binding(
+        np.concatenate([x.indices for x in b]),
+        np.concatenate([x.weights for x in b]),
+        np.concatenate([x.offsets for x in b]),
+        b[0].scale_refs,
+        b[0].scale_lengths,
+        np.concatenate([x.single for x in b]),
+    )
+    return Piece(mesh, binding)
+
+
+def _pad(a: np.ndarray, width: int) -> np.ndarray:
+    if a.shape[1] == width:
+        return a
+    return np.concatenate([a, np.repeat(a[:, -1:], width - a.shape[1], 1)], 1)
+
+
+def covered_skin(body: AuthoringBody, mesh: Mesh, reach: float = 0.02) -> np.ndarray:
+    """(D,) int32 skin vertices within ``reach`` of the garment (to hide if the user asks)."""
+    tree = cKDTree(mesh.vertices)
+    d, _ = tree.query(body.vertices[:SKIN], distance_upper_bound=reach)
+    return np.flatnonzero(np.isfinite(d)).astype(np.int32)

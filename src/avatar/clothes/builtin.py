@@ -1,0 +1,182 @@
+"""The built-in wardrobe: garments cut from the body's own helper geometry.
+
+Each entry is a short recipe (which faces, how much ease, fabric, colour, thickness,
+layer); ``build(name, body)`` turns it into a Garment bound to the base mesh, so it follows
+every body from babies to old people. Nothing is downloaded: the geometry comes from the
+MakeHuman base mesh Avatar already needs, the textures from ``fabrics``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar.clothes import fabrics, hair, textures
+from avatar.clothes.authoring import (
+    AuthoringBody,
+    Piece,
+    bound,
+    covered_skin,
+    cut,
+    join,
+    single_references,
+)
+from avatar.clothes.fitting import Garment
+from avatar.clothes.regions import face_features
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A built-in garment's recipe."""
+
+    name: str
+    category: str  # tops, bottoms, dresses, swimwear, legwear, footwear, headwear, hair, face
+    make: Callable[[AuthoringBody], Piece]
+    fabric: str
+    colour: str
+    thickness: float
+    z_depth: int
+    tags: tuple[str, ...] = ()
+    collide: bool = True
+
+
+def _tights(body: AuthoringBody, keep_fn, ease) -> Piece:
+    faces = body.group_faces("helper-tights")
+    ff = face_features(body.vertices, faces, body.part, body.marks)
+    return bound(body, cut(body, faces, keep_fn(ff, body.marks), ease), faces)
+
+
+def _skirt(body: AuthoringBody, bottom_z: float, ease) -> Piece:
+    faces = body.group_faces("helper-skirt")
+    centre_z = body.vertices[faces].mean(axis=1)[:, 2]
+    return bound(body, cut(body, faces, centre_z > bottom_z, ease), faces)
+
+
+def _z(ff):
+    return ff.centre[:, 2]
+
+
+def top(sleeve: float, neck: float = 0.0, hem: float = 0.04):
+    """Torso above the hip line (+hem), sleeves to ``sleeve`` along the arm."""
+
+    def keep(ff, m):
+        torso = (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + hem) & (_z(ff) < m.neck[2] - neck)
+        return torso | ((ff.part == "arm") & (ff.arm < sleeve))
+
+    return keep
+
+
+def bottom(length: float, rise: float = 0.07):
+    """Pelvis up to ``rise`` above the hip joints, legs to ``length`` along the leg."""
+
+    def keep(ff, m):
+        pelvis = (ff.part == "torso") & (_z(ff) < m.hip[0, 2] + rise)
+        return pelvis | ((ff.part == "leg") & (ff.leg < length))
+
+    return keep
+
+
+def tank(ff, m):
+    armhole = (np.abs(ff.centre[:, 0]) > 0.7 * abs(m.shoulder[0, 0])) & (_z(ff) > m.chest_z - 0.06)
+    body = (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.04) & (_z(ff) < m.neck[2] - 0.07)
+    return body & ~armhole
+
+
+def swimsuit(ff, m):
+    return (ff.part == "torso") & (_z(ff) < m.chest_z + 0.02) & (_z(ff) > m.hip[0, 2] - 0.15)
+
+
+def socks(ff, m):
+    return (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > 0.78))
+
+
+def shoes(ff, m):
+    return (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > 0.96))
+
+
+def bodice(ff, m):
+    return (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.02) & (_z(ff) < m.chest_z + 0.05)
+
+
+def flare(base: float, extra: float, start: float = 0.0):
+    """Ease growing down a limb (trouser legs hang straight from the widest part)."""
+    return lambda p, arm, leg: base + extra * np.clip((leg - start) / (1 - start), 0, 1)
+
+
+def sleeve_ease(base: float, extra: float):
+    return lambda p, arm, leg: base + extra * np.clip(arm, 0, 1)
+
+
+def _dress(body: AuthoringBody) -> Piece:
+    top_piece = _tights(body, bodice, 0.004)
+    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.004, 0.05))
+    return join([top_piece, skirt_piece])
+
+
+def _skirt_ease(body: AuthoringBody, base: float, extra: float):
+    hip, knee = body.marks.hip[0, 2], body.marks.knee[0, 2]
+    return lambda p, arm, leg: base + extra * np.clip((hip - p[:, 2]) / (hip - knee), 0, 1.5)
+
+
+def _cap(body: AuthoringBody) -> Piece:
+    crown = hair.scalp(body, 0.014, front=0.045, side=0.035, back=0.0)
+    return join([crown, hair.brim(body, crown)])
+
+
+SPECS = [
+    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02)), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),
+    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.97), sleeve_ease(0.006, 0.012)), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),
+    Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),
+    Spec("jacket", "tops", lambda b: _tights(b, top(0.98, neck=-0.03, hem=-0.03), sleeve_ease(0.016, 0.01)), "leather", "black", 0.003, 60, ("jacket", "outerwear")),
+    Spec("hoodie", "tops", lambda b: _tights(b, top(0.97, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012)), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),
+    Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),
+    Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),
+    Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),
+    Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),
+    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03)), "cotton", "red", 0.0015, 36, ("skirt",)),
+    Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
+    Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),
+    Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),
+    Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),
+    Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
+    Spec("hair-short", "hair", lambda b: hair.scalp(b, 0.006), "hair", "dark brown hair", 0.008, 70, ("hair", "short")),
+    Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),
+    Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),
+    Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),
+    Spec("eyelashes", "face", lambda b: join([single_references(b, g) for g in EYELASH_GROUPS]), "hair", "black hair", 0.0, 5, ("eyelashes",), False),
+]  # fmt: skip
+
+EYELASH_GROUPS = (
+    "helper-l-eyelashes-1",
+    "helper-l-eyelashes-2",
+    "helper-r-eyelashes-1",
+    "helper-r-eyelashes-2",
+)
+BY_NAME = {s.name: s for s in SPECS}
+
+
+def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
+    """A built-in Garment from its recipe on the authoring body."""
+    piece = spec.make(body)
+    if spec.category in ("hair", "face"):
+        material = textures.hair_material(spec, texture_size)
+    else:
+        material = fabrics.material(spec.fabric, spec.colour, texture_size, name=spec.name)
+    # Face proxies are drawn on the skin; holes there would show through, so they hide nothing.
+    delete = covered_skin(body, piece.mesh) if spec.collide else np.zeros(0, np.int32)
+    return Garment(
+        name=spec.name,
+        mesh=piece.mesh,
+        binding=piece.binding,
+        material=material,
+        z_depth=spec.z_depth,
+        delete_verts=delete,
+        thickness=spec.thickness,
+        collide=spec.collide,
+        category=spec.category,
+        tags=spec.tags,
+        source="builtin",
+        licence="CC0 (generated by Avatar from MakeHuman's CC0 base mesh)",
+    )

@@ -1,0 +1,169 @@
+"""Head pieces grown from the skin: hair caps, hair cards, a cap's brim, eyebrows.
+
+Hair textures share one layout: v in [0.5, 1] is dense (caps), v in [0, 0.5] is strand cards
+from root (v = 0.5) to tip (v = 0), their alpha thinning towards the tips.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar.clothes.authoring import SKIN, AuthoringBody, Piece, bound, cut, orient_outward
+from avatar.clothes.shell import boundary_edges
+from avatar.mesh import Mesh
+
+
+def eye_level(body: AuthoringBody) -> tuple[np.ndarray, float]:
+    """(head centre (3,), eye height z) of the authoring body."""
+    left, right = body.centre("helper-l-eye"), body.centre("helper-r-eye")
+    head = body.vertices[:SKIN][body.part[:SKIN] == "head"]
+    centre = np.array([0.0, head[:, 1].mean(), (left[2] + right[2]) / 2])
+    return centre, float(centre[2])
+
+
+def scalp_mask(body: AuthoringBody, front: float, side: float, back: float) -> np.ndarray:
+    """(F,) bool skin faces above a hairline: heights above eye level at the front, the
+    sides and the back, blended by the direction around the head; ears are left out."""
+    centre, eye_z = eye_level(body)
+    faces = body.skin_faces
+    c = body.vertices[faces].mean(axis=1)
+    rel = c - centre
+    facing = -rel[:, 1] / np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-6)  # +1 front
+    line = eye_z + side + (front - side) * np.maximum(facing, 0) + (back - side) * np.maximum(
+        -facing, 0
+    )
+    ear = (np.abs(rel[:, 0]) > 0.068) & (c[:, 2] < eye_z + 0.035)
+    head = body.part[faces].tolist()
+    is_head = np.array([row.count("head") >= 2 for row in head])
+    return is_head & (c[:, 2] > line) & ~ear & (c[:, 2] > eye_z - 0.09)
+
+
+def cap_uvs(mesh: Mesh, centre: np.ndarray) -> Mesh:
+    """UVs of a scalp cap in the dense half of the hair texture (u around, v up)."""
+    rel = mesh.vertices[mesh.faces] - centre  # (F, C, 3)
+    angle = np.arctan2(rel[..., 0], -rel[..., 1])
+    u = (angle / np.pi + 1) * 2.0
+    v = 0.5 + 0.5 * np.clip((rel[..., 2] + 0.1) / 0.25, 0, 1)
+    uv = np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)
+    return Mesh(mesh.vertices, mesh.faces, uv, np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape))
+
+
+def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) -> Piece:
+    """A hair or cap shell over the scalp, bound to the skin."""
+    faces = body.skin_faces
+    mesh = cut(body, faces, scalp_mask(body, front, side, back), ease)
+    centre, _ = eye_level(body)
+    return bound(body, cap_uvs(mesh, centre), faces)
+
+
+def helper_cards(body: AuthoringBody, layers=(0.006, 0.014, 0.022)) -> Piece:
+    """Long hair: MakeHuman's ``helper-hair`` strips, repeated in layers for volume, with
+    strand UVs (v 0.5 at the roots down to 0 at the tips)."""
+    fidx = body.base.face_groups["helper-hair"]
+    src = body.base.faces[fidx]
+    used, inv = np.unique(src, return_inverse=True)
+    pts = body.vertices[used]
+    local = inv.reshape(src.shape).astype(np.int32)
+    top, low = pts[:, 2].max(), pts[:, 2].min()
+    centre, _ = eye_level(body)
+    meshes = []
+    for k, ease in enumerate(layers):
+        p = pts + ease * body.outward(pts)
+        rel = p - centre
+        u = (np.arctan2(rel[:, 0], -rel[:, 1]) / np.pi + 1) * 3.0 + 0.37 * k
+        v = 0.5 * (p[:, 2] - low) / (top - low)
+        meshes.append((p, np.stack([u, v], 1)))
+    verts = np.concatenate([m[0] for m in meshes]).astype(np.float32)
+    uvs = np.concatenate([m[1] for m in meshes]).astype(np.float32)
+    faces = np.concatenate([local + i * len(pts) for i in range(len(layers))])
+    mesh = orient_outward(body, verts, faces)
+    mesh = Mesh(mesh.vertices, mesh.faces, uvs, mesh.faces.copy())
+    return bound(body, mesh, body.skin_faces)
+
+
+def ponytail(body: AuthoringBody, length: float = 0.3, cards: int = 4, rows: int = 12) -> Piece:
+    """A tied-back tail: crossed strand cards hanging from the back of the head."""
+    centre, eye_z = eye_level(body)
+    back = body.vertices[:SKIN][body.part[:SKIN] == "head"][:, 1].max()
+    root = np.array([0.0, back + 0.01, eye_z + 0.02])
+    t = np.linspace(0, 1, rows + 1)
+    # The tail falls back and down, then down along the upper back.
+    spine = root + np.stack([0 * t, 0.05 * np.sin(t * np.pi / 2) + 0.03 * t, -length * t], 1)
+    width = 0.045 * (1 - 0.6 * t) + 0.01
+    verts, uvs, faces = [], [], []
+    for c in range(cards):
+        angle = np.pi * c / cards
+        side = np.array([np.cos(angle), np.sin(angle) * 0.5, 0.0])
+        start = len(verts) and sum(len(x) for x in verts)
+        left = spine - width[:, None] * side
+        right = spine + width[:, None] * side
+        verts.append(np.concatenate([left, right]))
+        u0 = 0.3 * c
+        uvs.append(np.concatenate([np.stack([np.full_like(t, u0), 0.5 * (1 - t)], 1),
+                                   np.stack([np.full_like(t, u0 + 0.25), 0.5 * (1 - t)], 1)]))
+        i = np.arange(rows)
+        n = rows + 1
+        faces.append(np.stack([i, i + 1, n + i + 1, n + i], 1) + start)
+    mesh = Mesh(
+        np.concatenate(verts).astype(np.float32),
+        np.concatenate(faces).astype(np.int32),
+        np.concatenate(uvs).astype(np.float32),
+        np.concatenate(faces).astype(np.int32),
+    )
+    return bound(body, mesh, body.skin_faces)
+
+
+def brim(body: AuthoringBody, cap: Piece, reach: float = 0.07) -> Piece:
+    """A cap's visor: the front half of the crown's rim extended forward and slightly down."""
+    mesh = cap.mesh
+    edges, _ = boundary_edges(mesh.faces)
+    centre, _ = eye_level(body)
+    rel = mesh.vertices - centre
+    facing = -rel[:, 1] / np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-6)
+    front = (facing[edges[:, 0]] > 0.2) & (facing[edges[:, 1]] > 0.2)
+    edges = edges[front]
+    rim = np.unique(edges)
+    out = rel[rim] * np.array([1, 1, 0])
+    out /= np.linalg.norm(out, axis=1, keepdims=True)
+    strength = np.clip((facing[rim] - 0.2) / 0.5, 0, 1) ** 0.7
+    tip = mesh.vertices[rim] + (reach * strength)[:, None] * out + [0, 0, -0.012]
+    index = {int(v): i for i, v in enumerate(rim)}
+    n = len(rim)
+    verts = np.concatenate([mesh.vertices[rim], tip]).astype(np.float32)
+    faces = np.array([[index[a], index[b], n + index[b], n + index[a]] for a, b in edges], np.int32)
+    uv = np.concatenate([np.stack([rel[rim, 0] / 0.1, np.zeros(n)], 1),
+                         np.stack([rel[rim, 0] / 0.1, np.full(n, 0.6)], 1)]).astype(np.float32)
+    visor = orient_up(Mesh(verts, faces, uv, faces.copy()))
+    return bound(body, visor, body.skin_faces)
+
+
+def orient_up(mesh: Mesh) -> Mesh:
+    """Make a near-horizontal sheet's faces point up (+Z)."""
+    v = mesh.vertices[mesh.faces]
+    n = np.cross(v[:, 2] - v[:, 0], v[:, 3] - v[:, 1])
+    flip = n[:, 2] < 0
+    faces = mesh.faces.copy()
+    faces[flip] = faces[flip][:, [2, 1, 0, 3]]
+    fuv = mesh.face_uvs.copy()
+    fuv[flip] = fuv[flip][:, [2, 1, 0, 3]]
+    return Mesh(mesh.vertices, faces, mesh.uvs, fuv)
+
+
+def eyebrows(body: AuthoringBody) -> Piece:
+    """Two brow patches on the skin above the eyes, UVs spanning each brow."""
+    faces = body.skin_faces
+    c = body.vertices[faces].mean(axis=1)
+    keep = np.zeros(len(faces), bool)
+    for group in ("helper-l-eye", "helper-r-eye"):
+        eye = body.centre(group)
+        s = (c[:, 0] - eye[0]) / 0.03  # -1..1 across the brow
+        arch = eye[2] + 0.017 + 0.004 * (1 - s**2) - 0.004 * s * np.sign(eye[0])
+        keep |= (np.abs(s) < 1) & (np.abs(c[:, 2] - arch) < 0.0075) & (c[:, 1] < eye[1])
+    mesh = cut(body, faces, keep, 0.0006)
+    v = mesh.vertices[mesh.faces]
+    eye_x = np.where(v[..., 0] > 0, body.centre("helper-l-eye")[0], body.centre("helper-r-eye")[0])
+    u = 0.5 + (v[..., 0] - eye_x) / 0.065
+    w = 0.5 + (v[..., 2] - v[..., 2].mean()) / 0.02
+    uv = np.stack([u, w], -1).reshape(-1, 2).astype(np.float32)
+    mesh = Mesh(mesh.vertices, mesh.faces, uv, np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape))
+    return bound(body, mesh, faces)
