@@ -30,13 +30,36 @@ BODIES = {
 
 def bodies() -> Path:
     model = BodyModel.load()
-    chars = [
-        scene.character_from_human(Human(p, model=model), name=n) for n, p in BODIES.items()
-    ]
+    chars = [scene.character_from_human(Human(p, model=model), name=n) for n, p in BODIES.items()]
     return render.render_grid(chars, IMAGES / "bodies.png", spacing=0.9,
                               resolution=(1800, 700), samples=48)  # fmt: skip
 
 
+def _strip(human, animation, path: Path, every: int) -> Path:
+    character = scene.character_from_human(human, animation=animation)
+    return render.render_strip(character, path, every=every, panel=(240, 400), samples=24)
+
+
+def motion() -> list[Path]:
+    """docs/images/walk.png (built-in walk) and jump.png (CMU 01_01, from the test fixtures)."""
+    import avatar
+
+    model = BodyModel.load()
+    walker = Human({"gender": 0.8, "age": 0.35}, model=model).dressed(
+        "tshirt", "jeans", "shoes", "hair-short", "eyebrows")  # fmt: skip
+    out = [
+        _strip(walker, avatar.walk(walker.skeleton, seconds=1.0, fps=24), IMAGES / "walk.png", 4)
+    ]
+    clip = Path(__file__).resolve().parents[2] / "shared/fixtures/bvh/cmu_motionbuilder"
+    if (clip / "01_01_forward_jumps.bvh").is_file():
+        jumper = Human({"gender": 0.1, "muscle": 0.7}, model=model).dressed(
+            "tanktop", "leggings", "shoes", "hair-ponytail", "eyebrows")  # fmt: skip
+        skeleton, anim = avatar.load_bvh(clip / "01_01_forward_jumps.bvh")
+        jump, _ = avatar.retarget(skeleton, anim, jumper.skeleton, frames=slice(120, 360), fps=24)
+        out.append(_strip(jumper, jump, IMAGES / "jump.png", 8))
+    return out
+
+
 if __name__ == "__main__":
-    for name in sys.argv[1:] or ["bodies"]:
+    for name in sys.argv[1:] or ["bodies", "motion"]:
         print(globals()[name]())
