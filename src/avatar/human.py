@@ -101,8 +101,9 @@ class Human:
     def part(self, name: str) -> Mesh:
         """A renderable part ("body", "eyes") as its own Mesh (helpers excluded)."""
         base = self.model.base
-        faces = np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]])
-        return base.with_vertices(self.vertices).subset(np.sort(faces))
+        faces = np.sort(np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]]))
+        mesh = base.with_vertices(self.vertices).subset(faces)
+        return _eye_uvs(mesh, faces, base) if name == "eyes" else mesh
 
     def part_vertices(self, name: str) -> np.ndarray:
         """Indices into ``vertices`` of a part's vertices, in the part mesh's order."""
@@ -242,3 +243,17 @@ class Human:
                 out.avatar_params[key] = value
         out.clothes = list(self.recipe.clothes)
         return out
+
+
+def _eye_uvs(mesh: Mesh, faces: np.ndarray, base: Mesh) -> Mesh:
+    """The eyes with UVs spread over the procedural eye texture (one texture, both eyes)."""
+    from avatar import skin
+
+    assert mesh.uvs is not None and mesh.face_uvs is not None
+    left = np.isin(faces, base.face_groups["helper-l-eye"])
+    corners = mesh.uvs[mesh.face_uvs]  # (F, 4, 2) UV per face corner
+    out = np.empty_like(corners)
+    for side, rows in (("l", left), ("r", ~left)):
+        out[rows] = skin.eye_uvs(corners[rows].reshape(-1, 2), side).reshape(-1, 4, 2)
+    face_uvs = np.arange(out.shape[0] * out.shape[1], dtype=np.int32).reshape(out.shape[:2])
+    return replace(mesh, uvs=out.reshape(-1, 2), face_uvs=face_uvs)
