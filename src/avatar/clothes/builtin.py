@@ -85,7 +85,7 @@ def tank(ff, m):
 
 
 def swimsuit(ff, m):
-    return (ff.part == "torso") & (_z(ff) < m.chest_z + 0.02) & (_z(ff) > m.hip[0, 2] - 0.15)
+    return (ff.part == "torso") & (_z(ff) < m.chest_z + 0.11) & (_z(ff) > m.hip[0, 2] - 0.15)
 
 
 def socks(ff, m):
@@ -97,7 +97,7 @@ def shoes(ff, m):
 
 
 def bodice(ff, m):
-    return (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.02) & (_z(ff) < m.chest_z + 0.05)
+    return (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.02) & (_z(ff) < m.chest_z + 0.12)
 
 
 def flare(base: float, extra: float, start: float = 0.0):

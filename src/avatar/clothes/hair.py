@@ -59,13 +59,16 @@ def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) 
 def helper_cards(body: AuthoringBody, layers=(0.006, 0.014, 0.022)) -> Piece:
     """Long hair: MakeHuman's ``helper-hair`` strips, repeated in layers for volume, with
     strand UVs (v 0.5 at the roots down to 0 at the tips)."""
-    fidx = body.base.face_groups["helper-hair"]
-    src = body.base.faces[fidx]
+    src = body.group_faces("helper-hair")
+    centre, eye_z = eye_level(body)
+    mid = body.vertices[src].mean(axis=1)
+    # MakeHuman's strips include fringe locks over the face; a style you can see through keeps
+    # only those beside and behind the eyes.
+    src = src[~((mid[:, 1] < centre[1] - 0.02) & (mid[:, 2] < eye_z + 0.04))]
     used, inv = np.unique(src, return_inverse=True)
     pts = body.vertices[used]
     local = inv.reshape(src.shape).astype(np.int32)
     top, low = pts[:, 2].max(), pts[:, 2].min()
-    centre, _ = eye_level(body)
     meshes = []
     for k, ease in enumerate(layers):
         p = pts + ease * body.outward(pts)
