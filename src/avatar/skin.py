@@ -166,7 +166,7 @@ def region_masks(size: int, data_dir: Path | None = None) -> dict[str, np.ndarra
     present = {n: p for n, p in files.items() if p.is_file()}
     if len(present) < len(files):
         log.warning("skin masks missing: %s", ", ".join(sorted(set(files) - set(present))))
-    key = hashlib.sha256(repr(size).encode())
+    key = hashlib.sha256(f"v2 {size}".encode())
     for name, path in sorted(present.items()):
         stat = path.stat()
         key.update(f"{name}:{path}:{stat.st_size}:{stat.st_mtime_ns}".encode())
@@ -183,6 +183,8 @@ def _cached_masks(key: str, files: tuple[tuple[str, Path], ...], size: int):
         except (OSError, ValueError, KeyError):
             log.warning("ignoring unreadable skin mask cache %s", cache)
     masks8 = {name: _resize(jpeg.read(path), size) for name, path in files}
+    for m in masks8.values():
+        m[m < 4] = 0  # JPEG ringing leaves faint noise everywhere; it is not a region
     try:
         cache.parent.mkdir(parents=True, exist_ok=True)
         tmp = cache.with_suffix(".tmp.npz")
@@ -277,20 +279,29 @@ def _base_skin(tone: np.ndarray, size: int, rng: np.random.Generator, age: float
 
 
 def _paint_regions(colour, rough, tone, masks: dict[str, np.ndarray]) -> None:
-    """Blend each masked region's tint and roughness in place."""
+    """Blend each masked region's tint and roughness in place (within its bounding box)."""
     nail, mouth = _linear(NAIL_SRGB), _linear(MOUTH_SRGB)
     for name, (_, tint, region_rough) in REGIONS.items():
-        if name not in masks:
+        if name not in masks or not masks[name].any():
             continue
-        m = masks[name][..., None]
+        box = _bounding_box(masks[name])
+        m = masks[name][box][..., None]
+        c = colour[box]
         if tint is not None:
-            target = colour * np.asarray(tint, np.float32)
+            target = c * np.asarray(tint, np.float32)
         elif name == "inside-mouth":
-            target = np.broadcast_to(mouth, colour.shape)
+            target = mouth
         else:  # nails: pale, taking a little of the skin's colour through them
-            target = np.broadcast_to(0.75 * nail + 0.25 * tone, colour.shape)
-        colour[:] = colour * (1 - m) + target * m
-        rough[:] = rough * (1 - m[..., 0]) + region_rough * m[..., 0]
+            target = 0.75 * nail + 0.25 * tone
+        colour[box] = c + (target - c) * m
+        rough[box] += (np.float32(region_rough) - rough[box]) * m[..., 0]
+
+
+def _bounding_box(mask: np.ndarray) -> tuple[slice, slice]:
+    """Row and column slices enclosing the non-zero pixels of a (H, W) mask."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    return slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1)
 
 
 def _paint_mouth_parts(colour, rough) -> None:
@@ -323,7 +334,7 @@ def eye_uvs(uvs: np.ndarray, side: str) -> np.ndarray:
 def eye_material(
     iris: str | tuple[int, int, int] = "brown",
     *,
-    size: int = 512,
+    size: int = 1024,
     seed: int = 0,
     pupil: float = 7.0,
 ) -> Material:
@@ -397,9 +408,10 @@ def _iris(theta, phi, base: np.ndarray, pupil: float, rng) -> tuple[np.ndarray, 
 def _sclera(theta, phi, rng) -> np.ndarray:
     """Off-white sclera, pinker and veined away from the cornea, with a faint limbal shadow."""
     white = _linear((236, 230, 222))
-    pink = _linear((226, 180, 170))
-    veins = np.clip(_periodic_noise(rng, phi, 40) * 0.5 + _periodic_noise(rng, phi, 110), 0, 1)
-    redness = np.clip((theta - 40.0) / 50.0, 0, 1) * (0.35 + 0.65 * veins**3)
+    pink = _linear((222, 170, 160))
+    # Thin vessels: only the peaks of fine azimuthal noise, fading in towards the cornea.
+    veins = np.clip(_periodic_noise(rng, phi, 150) + 0.3 * _periodic_noise(rng, phi, 37), 0, 1)
+    redness = np.clip((theta - 45.0) / 60.0, 0, 1) * (0.15 + 0.5 * veins**8)
     colour = white * (1 - redness[..., None]) + pink * redness[..., None]
     shade = 1.0 - 0.12 * np.exp(-(((theta - 30.0) / 4.0) ** 2))
     return (colour * shade[..., None]).astype(np.float32)
