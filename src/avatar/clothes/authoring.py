@@ -89,9 +89,9 @@ def orient_outward(body: AuthoringBody, points: np.ndarray, faces: np.ndarray) -
     n = np.cross(v[:, 2] - v[:, 0], v[:, 3 % faces.shape[1]] - v[:, 1])
     inward = np.einsum("fd,fd->f", n, body.outward(v.mean(axis=1))) < 0
     faces = faces.copy()
-    faces[inward] = faces[inward][:, [2, 1, 0, 3]] if faces.shape[1] == 4 else faces[inward][
-        :, [0, 2, 1]
-    ]
+    faces[inward] = (
+        faces[inward][:, [2, 1, 0, 3]] if faces.shape[1] == 4 else faces[inward][:, [0, 2, 1]]
+    )
     return Mesh(vertices=points, faces=faces)
 
 
@@ -124,7 +124,9 @@ def single_references(body: AuthoringBody, group: str, uvs_from_base: bool = Tru
     used = np.unique(body.base.faces[fidx])
     n = len(used)
     binding = make_binding(
-        np.repeat(used[:, None], 3, 1), np.tile([1.0, 0, 0], (n, 1)), np.zeros((n, 3)),
+        np.repeat(used[:, None], 3, 1),
+        np.tile([1.0, 0, 0], (n, 1)),
+        np.zeros((n, 3)),
         single=np.ones(n, bool),
     )
     return Piece(mesh, binding)

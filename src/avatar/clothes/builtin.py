@@ -126,26 +126,26 @@ def _cap(body: AuthoringBody) -> Piece:
 
 
 SPECS = [
-    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02)), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),
-    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.97), sleeve_ease(0.006, 0.012)), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),
-    Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),
-    Spec("jacket", "tops", lambda b: _tights(b, top(0.98, neck=-0.03, hem=-0.03), sleeve_ease(0.016, 0.01)), "leather", "black", 0.003, 60, ("jacket", "outerwear")),
-    Spec("hoodie", "tops", lambda b: _tights(b, top(0.97, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012)), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),
-    Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),
-    Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),
-    Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),
-    Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),
-    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03)), "cotton", "red", 0.0015, 36, ("skirt",)),
+    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02)), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
+    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.97), sleeve_ease(0.006, 0.012)), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
+    Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
+    Spec("jacket", "tops", lambda b: _tights(b, top(0.98, neck=-0.03, hem=-0.03), sleeve_ease(0.016, 0.01)), "leather", "black", 0.003, 60, ("jacket", "outerwear")),  # noqa: E501
+    Spec("hoodie", "tops", lambda b: _tights(b, top(0.97, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012)), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
+    Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
+    Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
+    Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
+    Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
+    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03)), "cotton", "red", 0.0015, 36, ("skirt",)),  # noqa: E501
     Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
-    Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),
-    Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),
-    Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),
+    Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
+    Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
+    Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
-    Spec("hair-short", "hair", lambda b: hair.scalp(b, 0.006), "hair", "dark brown hair", 0.008, 70, ("hair", "short")),
-    Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),
-    Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),
-    Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),
-    Spec("eyelashes", "face", lambda b: join([single_references(b, g) for g in EYELASH_GROUPS]), "hair", "black hair", 0.0, 5, ("eyelashes",), False),
+    Spec("hair-short", "hair", lambda b: hair.scalp(b, 0.006), "hair", "dark brown hair", 0.008, 70, ("hair", "short")),  # noqa: E501
+    Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),  # noqa: E501
+    Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
+    Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
+    Spec("eyelashes", "face", lambda b: join([single_references(b, g) for g in EYELASH_GROUPS]), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
 ]  # fmt: skip
 
 EYELASH_GROUPS = (

@@ -29,8 +29,11 @@ def scalp_mask(body: AuthoringBody, front: float, side: float, back: float) -> n
     c = body.vertices[faces].mean(axis=1)
     rel = c - centre
     facing = -rel[:, 1] / np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-6)  # +1 front
-    line = eye_z + side + (front - side) * np.maximum(facing, 0) + (back - side) * np.maximum(
-        -facing, 0
+    line = (
+        eye_z
+        + side
+        + (front - side) * np.maximum(facing, 0)
+        + (back - side) * np.maximum(-facing, 0)
     )
     ear = (np.abs(rel[:, 0]) > 0.068) & (c[:, 2] < eye_z + 0.035)
     head = body.part[faces].tolist()
@@ -45,7 +48,13 @@ def cap_uvs(mesh: Mesh, centre: np.ndarray) -> Mesh:
     u = (angle / np.pi + 1) * 2.0
     v = 0.5 + 0.5 * np.clip((rel[..., 2] + 0.1) / 0.25, 0, 1)
     uv = np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)
-    return Mesh(mesh.vertices, mesh.faces, uv, np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape))
+    return per_corner(mesh, uv)
+
+
+def per_corner(mesh: Mesh, uv: np.ndarray) -> Mesh:
+    """The mesh with one UV per face corner: uv (F * C, 2) in face-corner order."""
+    corners = np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape)
+    return Mesh(mesh.vertices, mesh.faces, uv, corners)
 
 
 def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) -> Piece:
@@ -102,8 +111,14 @@ def ponytail(body: AuthoringBody, length: float = 0.3, cards: int = 4, rows: int
         right = spine + width[:, None] * side
         verts.append(np.concatenate([left, right]))
         u0 = 0.3 * c
-        uvs.append(np.concatenate([np.stack([np.full_like(t, u0), 0.5 * (1 - t)], 1),
-                                   np.stack([np.full_like(t, u0 + 0.25), 0.5 * (1 - t)], 1)]))
+        uvs.append(
+            np.concatenate(
+                [
+                    np.stack([np.full_like(t, u0), 0.5 * (1 - t)], 1),
+                    np.stack([np.full_like(t, u0 + 0.25), 0.5 * (1 - t)], 1),
+                ]
+            )
+        )
         i = np.arange(rows)
         n = rows + 1
         faces.append(np.stack([i, i + 1, n + i + 1, n + i], 1) + start)
@@ -134,8 +149,12 @@ def brim(body: AuthoringBody, cap: Piece, reach: float = 0.07) -> Piece:
     n = len(rim)
     verts = np.concatenate([mesh.vertices[rim], tip]).astype(np.float32)
     faces = np.array([[index[a], index[b], n + index[b], n + index[a]] for a, b in edges], np.int32)
-    uv = np.concatenate([np.stack([rel[rim, 0] / 0.1, np.zeros(n)], 1),
-                         np.stack([rel[rim, 0] / 0.1, np.full(n, 0.6)], 1)]).astype(np.float32)
+    uv = np.concatenate(
+        [
+            np.stack([rel[rim, 0] / 0.1, np.zeros(n)], 1),
+            np.stack([rel[rim, 0] / 0.1, np.full(n, 0.6)], 1),
+        ]
+    ).astype(np.float32)
     visor = orient_up(Mesh(verts, faces, uv, faces.copy()))
     return bound(body, visor, body.skin_faces)
 
@@ -168,5 +187,5 @@ def eyebrows(body: AuthoringBody) -> Piece:
     u = 0.5 + (v[..., 0] - eye_x) / 0.065
     w = 0.5 + (v[..., 2] - v[..., 2].mean()) / 0.02
     uv = np.stack([u, w], -1).reshape(-1, 2).astype(np.float32)
-    mesh = Mesh(mesh.vertices, mesh.faces, uv, np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape))
+    mesh = per_corner(mesh, uv)
     return bound(body, mesh, faces)

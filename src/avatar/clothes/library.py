@@ -89,9 +89,7 @@ def load_garment(
     raise unknown_name("garment", text, [e.name for e in list_garments(folders=folders)])
 
 
-def dress(
-    human, garments: Sequence[Garment | str] = DEFAULT_OUTFIT, bone_names=None
-) -> Outfit:
+def dress(human, garments: Sequence[Garment | str] = DEFAULT_OUTFIT, bone_names=None) -> Outfit:
     """Fit garments (Garment records or names/paths) on a human; see ``fitting.dress``."""
     loaded = [g if isinstance(g, Garment) else load_garment(g) for g in garments]
     return fitting.dress(human, loaded, bone_names)
@@ -134,4 +132,3 @@ __all__ = [
     "parts",
     "user_folders",
 ]
-
