@@ -66,10 +66,13 @@ def bind(
         )
     weights = bary[rows, best]
     indices = tri[rows, best]
-    lengths = np.abs(x[SCALE_REFS[:, 0], [0, 1, 2]] - x[SCALE_REFS[:, 1], [0, 1, 2]])
-    binding = make_binding(indices, weights, np.zeros_like(p), SCALE_REFS, lengths)
+    refs, lengths = None, None
+    if len(x) > SCALE_REFS.max():  # an hm08 body: offsets scale with it as in MakeHuman
+        refs = SCALE_REFS
+        lengths = np.abs(x[refs[:, 0], [0, 1, 2]] - x[refs[:, 1], [0, 1, 2]])
+    binding = make_binding(indices, weights, np.zeros_like(p), refs, lengths)
     offsets = (p - close[rows, best]) / axis_scale(binding, x)
-    return make_binding(indices, weights, offsets, SCALE_REFS, lengths)
+    return make_binding(indices, weights, offsets, refs, lengths)
 
 
 def save(

@@ -1,0 +1,173 @@
+"""Clothes building blocks: binding maths, collision, weights, shells, fabrics, binder, assets."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from avatar.clothes import binding, collision, fabrics, shell, weights
+from avatar.clothes.binder import bind, save
+from avatar.clothes.scan import scan
+from avatar.errors import AvatarError, FormatError
+from avatar.mesh import Mesh
+from avatar.rig.skinning import SkinWeights
+
+CUBE = Mesh(
+    vertices=np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], np.float32),
+    faces=np.array(
+        [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]],
+        np.int32,
+    ),
+)
+
+
+def test_fit_is_barycentric_plus_scaled_offset():
+    body = np.array([[0, 0, 0], [2, 0, 0], [0, 4, 0], [0, 0, 6]], np.float64)
+    b = binding.make_binding(
+        [[0, 1, 2]], [[0.25, 0.25, 0.5]], [[0.1, 0.1, 0.1]],
+        scale_refs=[[0, 1], [0, 2], [0, 3]], scale_lengths=[1.0, 2.0, 3.0],
+    )  # fmt: skip
+    # anchor = (0.5, 2, 0); S = (2/1, 4/2, 6/3) = 2 on every axis.
+    assert np.allclose(binding.fit(b, body), [[0.7, 2.2, 0.2]])
+    batch = binding.fit(b, np.stack([body, body * 2]))
+    assert batch.shape == (2, 1, 3) and np.allclose(batch[1], [[1.4, 4.4, 0.4]])
+
+
+def test_signed_distance_and_push_out_on_a_cube():
+    points = np.array([[0, 0, 0.5], [0, 0, 1.5], [0.9, 0.2, 0.1]], np.float32)
+    count, depth = collision.penetration(CUBE.vertices, CUBE.faces, points)
+    assert count == 2 and np.allclose(depth, [0.5, 0, 0.1], atol=1e-5)
+    surface = collision.body_surface(CUBE.faces)
+    q = collision.query(CUBE.vertices, surface, points, k=8)
+    assert np.allclose(q.distance, [-0.5, 0.5, -0.1], atol=1e-5)
+    moved = collision.push_out(points, q, 0.01)
+    assert collision.penetration(CUBE.vertices, CUBE.faces, moved)[0] == 0
+
+
+def test_transferred_weights_follow_the_references():
+    body = SkinWeights(np.array([[0, 1], [1, 2], [2, 0]], np.int32),
+                       np.array([[0.5, 0.5], [1.0, 0], [1.0, 0]], np.float32))  # fmt: skip
+    b = binding.make_binding([[0, 1, 2], [2, 2, 2]], [[0.5, 0.5, 0.0], [1, 0, 0]], np.zeros((2, 3)))
+    w = weights.transfer(b, body)
+    dense = np.zeros((2, 3))
+    np.add.at(dense, (np.arange(2)[:, None], w.indices), w.weights)
+    assert np.allclose(dense, [[0.25, 0.75, 0], [0, 0, 1]])
+
+
+def test_shell_is_closed_and_keeps_uvs():
+    sheet = Mesh(
+        np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0]], np.float32),
+        np.array([[0, 1, 2, 3], [1, 4, 5, 2]], np.int32),
+        np.zeros((8, 2), np.float32),
+        np.arange(8, dtype=np.int32).reshape(2, 4),
+    )
+    s = shell.solidify(sheet)
+    assert len(s.mesh.faces) == 2 + 2 + 6 and s.count == 6
+    edges, _ = shell.boundary_edges(s.mesh.faces)
+    assert len(edges) == 0  # watertight
+    verts = shell.extrude(sheet.vertices, np.tile([0, 0, 1.0], (6, 1)), 0.01)
+    assert verts.shape == (12, 3) and np.allclose(verts[6:, 2], 0.01)
+
+
+def test_fabrics_tile_seamlessly():
+    for name in ("cotton", "denim", "knit", "leather"):
+        h, normal, rough = fabrics.maps(name, 128)
+        assert normal.shape == (128, 128, 3) and rough.dtype == np.uint8
+        # Wrapping across the tile edge is no rougher than inside it.
+        seam = np.abs(h[0] - h[-1]).mean()
+        inner = np.abs(np.diff(h, axis=0)).mean()
+        assert seam < 3 * inner + 1e-6
+    m = fabrics.material("denim", "indigo", 64)
+    assert m.base_color_texture.shape == (64, 64, 3) and m.extras["fabric"] == "denim"
+
+
+def test_binder_reproduces_the_authored_garment_and_refuses_far_vertices():
+    garment = CUBE.vertices * 1.1
+    b = bind(garment, CUBE.vertices * 1.0, CUBE.faces)
+    assert np.allclose(binding.fit(b, CUBE.vertices), garment, atol=1e-6)
+    with pytest.raises(AvatarError, match="vertex 0"):
+        bind(np.array([[9.0, 0, 0]]), CUBE.vertices, CUBE.faces)
+
+
+def test_avatar2020_garments_bind_and_follow_new_bodies(model, fixtures):
+    from avatar.clothes.fitting import Garment, dress
+    from avatar.human import Human
+    from avatar.io import obj
+    from avatar.io.obj import to_avatar_frame
+
+    folder = fixtures / "avatar2020"
+    mean = to_avatar_frame(np.loadtxt(folder / "shape" / "StandardModel.txt").reshape(-1, 3))
+    faces = model.base.faces[model.base.face_groups["body"]]
+    garments = []
+    for name in ("shirt03", "pants01"):
+        mesh = obj.read(folder / "clothes" / f"{name}.obj", axes=obj.MAKEHUMAN)
+        b = bind(mesh.vertices, mean, faces)
+        assert np.abs(binding.fit(b, mean) - mesh.vertices).max() < 1e-5
+        garments.append(Garment(name, mesh, b, z_depth=40 + len(garments)))
+    human = Human({"weight": 1.0, "gender": 0.2, "age": 0.8}, model=model)
+    for fitted in dress(human, garments):
+        count, depth = collision.penetration(human.vertices[:13380], faces, fitted.mesh.vertices)
+        assert depth.max() <= 0.001, (fitted.name, count, depth.max())
+
+
+def test_saved_garment_loads_back(model, fixtures, tmp_path):
+    from avatar.clothes.asset import read_garment
+    from avatar.human import Human
+    from avatar.io import obj
+
+    body = Human({}, model=model).vertices  # the 2020 mean body is the default, grounded
+    mesh = obj.read(fixtures / "avatar2020" / "clothes" / "hat01.obj", axes=obj.MAKEHUMAN)
+    faces = model.base.faces[model.base.face_groups["body"]]
+    b = bind(mesh.vertices, body, faces)
+    path = save(tmp_path, "hat", mesh, b, tags=("Hat",))
+    g = read_garment(path)
+    assert g.name == "hat" and g.tags == ("hat",)
+    assert np.allclose(binding.fit(g.binding, body), mesh.vertices, atol=1e-5)
+
+
+@pytest.fixture
+def shoes(fixtures, tmp_path):
+    src = fixtures / "makehuman" / "clothes" / "shoes01"
+    dst = tmp_path / "shoes01"
+    shutil.copytree(src, dst)
+    return dst
+
+
+def test_fixture_garment_loads_with_its_weights_and_textures(shoes):
+    from avatar.clothes.asset import read_garment
+
+    g = read_garment(shoes / "shoes01.mhclo")
+    assert g.bone_weights is not None and g.material.base_color_texture is not None
+    assert g.licence == "CC0" and len(g.delete_verts) > 0
+
+
+@pytest.mark.parametrize("broken", ["missing obj", "missing texture", "wrong count"])
+def test_broken_garment_is_refused_naming_the_file(shoes, broken):
+    from avatar.clothes.asset import read_garment
+
+    if broken == "missing obj":
+        (shoes / "shoes01.obj").unlink()
+        culprit = "shoes01.mhclo"
+    elif broken == "missing texture":
+        (shoes / "shoes01_diffuse.png").unlink()
+        culprit = "shoes01.mhmat"
+    else:
+        text = (shoes / "shoes01.mhclo").read_text().splitlines()
+        start = next(i for i, line in enumerate(text) if line.startswith("verts"))
+        del text[start + 1]
+        (shoes / "shoes01.mhclo").write_text("\n".join(text))
+        culprit = "shoes01.mhclo"
+    with pytest.raises(FormatError) as info:
+        read_garment(shoes / "shoes01.mhclo")
+    assert culprit in str(info.value)
+
+
+def test_scanner_lists_makehuman_assets(fixtures):
+    entries = scan(fixtures / "makehuman")
+    names = {e.name for e in entries}
+    assert {"shoes01", "short02", "eyebrow001"} <= names
+    short = next(e for e in entries if e.name == "short02")
+    assert short.category == "hair" and short.licence == "CC0" and short.thumbnail
+    assert "short" in short.tags
