@@ -77,6 +77,17 @@ def skeleton() -> Skeleton:
     )
 
 
+def chain(count: int) -> Skeleton:
+    """``count`` bones stacked along +Z, 0.25 m each, rolls varying."""
+    heads = np.stack([np.zeros(count), np.zeros(count), 0.25 * np.arange(count)], axis=1)
+    tails = heads + (0.0, 0.0, 0.25)
+    rest = np.stack(
+        [bone_matrix(h, t, 0.4 * i) for i, (h, t) in enumerate(zip(heads, tails, strict=True))]
+    )
+    parents = np.arange(count, dtype=np.int32) - 1
+    return Skeleton(tuple(f"bone{i}" for i in range(count)), parents, rest, tails)
+
+
 def skin_weights(mesh: Mesh, k: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """(V, k) influences blending root->spine along Z, a little 'arm', zero-padded to k."""
     z = mesh.vertices[:, 2] / 2.0
@@ -90,10 +101,9 @@ def skin_weights(mesh: Mesh, k: int = 3) -> tuple[np.ndarray, np.ndarray]:
 
 
 def many_influences(count: int, k: int = 7, joints: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """(count, k) distinct-joint influences for a wide skeleton (forces JOINTS_1)."""
+    """(count, k) random influences, joints repeating within a vertex when k > joints."""
     rng = np.random.default_rng(1)
-    idx = np.stack([rng.permutation(joints)[:k] for _ in range(count)])
-    return idx.astype(np.int32), rng.random((count, k)) + 0.05
+    return rng.integers(0, joints, (count, k)).astype(np.int32), rng.random((count, k)) + 0.05
 
 
 def clip(sk: Skeleton, frames: int = 12, fps: float = 24.0) -> Animation:

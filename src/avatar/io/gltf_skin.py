@@ -116,7 +116,7 @@ def pack_weights(
     width = 4 if np.count_nonzero(w, axis=1).max(initial=0) <= 4 else 8
     idx, w = _pad(idx, width), _pad(w, width)
     w32 = (w / w.sum(axis=1, keepdims=True)).astype(np.float32)
-    # Put the float32 rounding residue on the largest weight so sums are 1 to the last bit.
+    # Put the float32 rounding residue on the largest weight: sums are 1 to about 1 ulp.
     w32[:, 0] = np.float32(1.0) - w32[:, 1:].sum(axis=1, dtype=np.float32)
     idx[w32 == 0] = 0
     return idx.astype(np.uint8 if joint_count <= 256 else np.uint16), w32
