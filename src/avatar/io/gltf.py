@@ -4,11 +4,11 @@ Spec: https://registry.khronos.org/glTF/specs/2.0/glTF-2.0.html . The suffix pic
 container: ``.glb`` (one binary file) or ``.gltf`` (JSON with the buffer as a side-car
 ``.bin`` or, with ``embed=True``, a data URI).
 
-Frames. glTF is Y-up; Avatar is Z-up. This module is the only place that converts:
-glTF ``(x, y, z) = (x, z, -y)``, the rotation ``AXES``. Every transform is conjugated by it
-(``M_gltf = AXES @ M @ AXES.T``), bone-local frames included, which is how Blender's own
-exporter works: importing into Blender gives back Avatar's bone rolls and pose quaternions
-exactly, and any other viewer skins the mesh identically.
+Frames. glTF is Y-up; Avatar is Z-up. This module and ``gltf_skin`` are the only places
+that convert: glTF ``(x, y, z) = (x, z, -y)``, the rotation ``AXES``. Positions, normals
+and morph deltas are rotated; bones keep their own local axes (see ``gltf_skin``), as
+Blender's exporter does, so importing into Blender gives back Avatar's bone rolls and pose
+quaternions exactly, and any viewer skins the mesh identically.
 
 Vertices. Avatar meshes carry UVs per face corner; glTF carries one UV per vertex, so a
 vertex on a UV seam becomes several glTF vertices. Quads are split along their 0-2

@@ -1,10 +1,12 @@
 """Skeleton, skin weights and animation for glTF 2.0 (spec sections 3.7.3 skins, 3.11 animations).
 
-Joints become nodes whose local TRS is the bone's rest matrix relative to its parent,
-conjugated into glTF's Y-up frame (see ``avatar.io.gltf``). A bone pose (Blender's pose-bone
-quaternion ``q`` and location ``t`` in the bone's rest frame) becomes the node's animated
-local transform ``local_rest @ T(t) R(q)``; reading inverts it, so rotations come back with
-their original sign.
+Frames, as Blender's own exporter writes them: a bone keeps its own local axes (Y from head
+to tail, rolled X/Z); only the world around it turns Y-up. So a joint's glTF world matrix is
+``AXES @ rest``, a root joint's local matrix is ``AXES @ rest`` and every other joint's local
+matrix is Avatar's (parent-relative) rest matrix unchanged. Blender's importer undoes exactly
+this, giving back Avatar's bone rolls and pose quaternions. A bone pose (pose-bone
+quaternion ``q``, location ``t``, both in the bone's rest frame) becomes the node's animated
+local transform ``local_rest @ T(t) R(q)``; reading inverts it, keeping the quaternion's sign.
 """
 
 from __future__ import annotations
@@ -21,30 +23,26 @@ AXES = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 MAX_INFLUENCES = 8
 
 
-def to_gltf_quat(q: np.ndarray) -> np.ndarray:
-    """(..., 4) Avatar (w, x, y, z) -> glTF (x, y, z, w) of the rotation AXES q AXES^T."""
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    return np.stack([x, z, -y, w], axis=-1)
-
-
-def from_gltf_quat(q: np.ndarray) -> np.ndarray:
-    """Inverse of ``to_gltf_quat``: glTF (x, y, z, w) -> Avatar (w, x, y, z)."""
-    x, y, z, w = np.moveaxis(np.asarray(q, dtype=np.float64), -1, 0)
-    return np.stack([w, x, -z, y], axis=-1)
-
-
-def to_gltf_matrix(m: np.ndarray) -> np.ndarray:
-    """(..., 4, 4) Avatar transforms -> glTF ones (conjugation by AXES)."""
+def _axes4() -> np.ndarray:
     a = np.eye(4)
     a[:3, :3] = AXES
-    return a @ m @ a.T
+    return a
 
 
-def from_gltf_matrix(m: np.ndarray) -> np.ndarray:
-    """Inverse of ``to_gltf_matrix``."""
-    a = np.eye(4)
-    a[:3, :3] = AXES
-    return a.T @ m @ a
+def gltf_local_rest(skeleton: Skeleton) -> np.ndarray:
+    """(J, 4, 4) joint node rest matrices: Avatar's local rest, roots turned Y-up."""
+    local = skeleton.local_rest()
+    roots = skeleton.parents < 0
+    local[roots] = _axes4() @ local[roots]
+    return local
+
+
+def _xyzw(q: np.ndarray) -> np.ndarray:
+    return np.roll(q, -1, axis=-1)
+
+
+def _wxyz(q) -> np.ndarray:
+    return np.roll(np.asarray(q, dtype=np.float64), 1, axis=-1)
 
 
 # ---------------------------------------------------------------------------- writing
@@ -52,9 +50,9 @@ def from_gltf_matrix(m: np.ndarray) -> np.ndarray:
 
 def add_skeleton(gltf: g.GLTF2, packer: acc.Packer, skeleton: Skeleton) -> int:
     """Add an armature node, one node per joint and the skin; return the skin index."""
-    local = skeleton.local_rest()
-    rotations = to_gltf_quat(quat.from_matrix(local[:, :3, :3]))
-    translations = local[:, :3, 3] @ AXES.T
+    local = gltf_local_rest(skeleton)
+    rotations = _xyzw(quat.from_matrix(local[:, :3, :3]))
+    translations = local[:, :3, 3]
     tails = skeleton.tails @ AXES.T
     first = len(gltf.nodes) + 1  # node index of joint 0 (the armature node comes first)
     armature = g.Node(name=str(skeleton.extra.get("name", "Armature")), children=[])
@@ -75,7 +73,7 @@ def add_skeleton(gltf: g.GLTF2, packer: acc.Packer, skeleton: Skeleton) -> int:
     for node in gltf.nodes[first - 1 :]:
         node.children = node.children or None
     gltf.scenes[0].nodes.append(first - 1)
-    inverse_bind = to_gltf_matrix(np.linalg.inv(skeleton.rest))
+    inverse_bind = np.linalg.inv(_axes4() @ skeleton.rest)
     gltf.skins.append(
         g.Skin(
             name=armature.name,
@@ -143,11 +141,11 @@ def add_animation(
 ) -> None:
     """One glTF animation: a rotation channel per bone, translation where it moves; LINEAR."""
     cols = [skeleton.index(n) for n in animation.bone_names]
-    local = skeleton.local_rest()[cols]
+    local = gltf_local_rest(skeleton)[cols]
     rotation = quat.multiply(quat.from_matrix(local[:, :3, :3])[None], animation.rotations)
     rotation = rotation / np.linalg.norm(rotation, axis=-1, keepdims=True)
     translation = np.einsum("jab,tjb->tja", local[:, :3, :3], animation.translations)
-    translation = (translation + local[None, :, :3, 3]) @ AXES.T
+    translation = translation + local[None, :, :3, 3]
     times = (np.arange(animation.frames) / float(animation.fps)).astype(np.float32)
     out = g.Animation(name=name, channels=[], samplers=[], extras={"fps": float(animation.fps)})
     time_accessor = packer.accessor(times, bounds=True)
@@ -155,7 +153,7 @@ def add_animation(
     moving = np.any(animation.translations != 0, axis=(0, 2))
     for k, j in enumerate(cols):
         node = joint_nodes[j]
-        keys = {"rotation": to_gltf_quat(rotation[:, k])}
+        keys = {"rotation": _xyzw(rotation[:, k])}
         if moving[k]:
             keys["translation"] = translation[:, k]
         for path, values in keys.items():
@@ -189,7 +187,7 @@ def read_skeleton(gltf: g.GLTF2, buffers: list[bytes]) -> tuple[Skeleton | None,
     world = {n: world_matrix(gltf, parent_node, n) for n in joint_nodes}
     joint_nodes = _parents_first(joint_nodes, parent_node)
     parents = np.array([_joint_parent(n, parent_node, joint_nodes) for n in joint_nodes])
-    rest = from_gltf_matrix(np.stack([world[n] for n in joint_nodes]))
+    rest = _axes4().T @ np.stack([world[n] for n in joint_nodes])
     tails = _tails(gltf, joint_nodes, rest, parents)
     root = parent_node.get(joint_nodes[0])
     extra = {"name": gltf.nodes[root].name} if root is not None and gltf.nodes[root].name else {}
@@ -203,7 +201,7 @@ def node_local(node: g.Node) -> np.ndarray:
         return np.array(node.matrix, dtype=np.float64).reshape(4, 4).T
     m = np.eye(4)
     if node.rotation is not None:
-        m[:3, :3] = quat.to_matrix(np.roll(np.array(node.rotation, dtype=np.float64), 1))
+        m[:3, :3] = quat.to_matrix(_wxyz(node.rotation))
     if node.scale is not None:
         m[:3, :3] = m[:3, :3] * np.array(node.scale)
     if node.translation is not None:
@@ -310,13 +308,10 @@ def _decode_pose(gltf, keyed, joint_nodes, frames: int):
         rest = node_local(gltf.nodes[n])
         rest_q = quat.from_matrix(rest[:3, :3])
         if gltf.nodes[n].rotation is not None:  # keep the stored sign, not from_matrix's
-            rest_q = np.roll(np.asarray(gltf.nodes[n].rotation, dtype=np.float64), 1)
+            rest_q = _wxyz(gltf.nodes[n].rotation)
         if (n, "rotation") in keyed:
-            q = np.roll(keyed[(n, "rotation")][1], 1, axis=-1)  # xyzw -> wxyz
-            rotations[:, j] = from_gltf_quat(
-                np.roll(quat.multiply(quat.conjugate(rest_q)[None], q), -1, axis=-1)
-            )
+            q = _wxyz(keyed[(n, "rotation")][1])
+            rotations[:, j] = quat.multiply(quat.conjugate(rest_q)[None], q)
         if (n, "translation") in keyed:
-            delta = (keyed[(n, "translation")][1] - rest[:3, 3]) @ rest[:3, :3]
-            translations[:, j] = delta @ AXES
+            translations[:, j] = (keyed[(n, "translation")][1] - rest[:3, 3]) @ rest[:3, :3]
     return rotations, translations
