@@ -125,6 +125,9 @@ def split_vertices(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None, np.ndarra
     if tri_uv is None or mesh.uvs is None:
         source, corners = np.unique(tris.reshape(-1), return_inverse=True)
         return source, None, corners.reshape(-1, 3)
+    # Equal UV values under different indices (per-corner UV lists) are one UV: no seam.
+    _, first, same = np.unique(mesh.uvs, axis=0, return_index=True, return_inverse=True)
+    tri_uv = first[same.reshape(-1)[tri_uv]]
     key = tris.reshape(-1).astype(np.int64) * len(mesh.uvs) + tri_uv.reshape(-1)
     unique, corners = np.unique(key, return_inverse=True)
     return unique // len(mesh.uvs), unique % len(mesh.uvs), corners.reshape(-1, 3)
