@@ -139,7 +139,7 @@ def value_noise(rng: np.random.Generator, size: int, cells: int) -> np.ndarray:
     lattice = rng.uniform(-1.0, 1.0, (cells + 1, cells + 1)).astype(np.float32)
     x = np.linspace(0.0, cells, size, endpoint=False, dtype=np.float32)
     i = np.minimum(x.astype(np.int32), cells - 1)
-    f = x - i
+    f = (x - i).astype(np.float32)
     f = f * f * (3 - 2 * f)
     rows = lattice[i] * (1 - f)[:, None] + lattice[i + 1] * f[:, None]  # (size, cells + 1)
     return rows[:, i] * (1 - f)[None, :] + rows[:, i + 1] * f[None, :]
@@ -252,14 +252,16 @@ def _skin_material(key: tuple, size: int, seed: int, data_dir: str | None) -> Ma
     colour, rough = _base_skin(tone, size, rng, age)
     _paint_regions(colour, rough, tone, masks)
     _paint_mouth_parts(colour, rough)
-    for image in (colour, rough):
-        image.flags.writeable = False
+    image = np.ascontiguousarray(_to_uint8(colour))
+    rough8 = np.rint(np.clip(rough, 0, 1) * 255).astype(np.uint8)
+    for array in (image, rough8):
+        array.flags.writeable = False  # shared by every caller of the cache
     return Material(
         name="skin",
         base_color=(1.0, 1.0, 1.0, 1.0),
-        base_color_texture=_to_uint8(colour),
+        base_color_texture=image,
         roughness=1.0,
-        roughness_texture=np.rint(np.clip(rough, 0, 1) * 255).astype(np.uint8),
+        roughness_texture=rough8,
         extras={"subsurface": 0.15, "subsurface_radius": [0.01, 0.004, 0.0025]},
     )
 
@@ -354,7 +356,7 @@ def _eye_material(rgb: tuple, size: int, seed: int, pupil: float) -> Material:
     colour = _sclera(theta, phi, rng)
     iris_colour, iris_alpha = _iris(theta, phi, _linear(rgb), pupil, rng)
     colour = colour * (1 - iris_alpha[..., None]) + iris_colour * iris_alpha[..., None]
-    image = _to_uint8(colour)
+    image = np.ascontiguousarray(_to_uint8(colour))
     image.flags.writeable = False
     return Material(
         name="eye",
