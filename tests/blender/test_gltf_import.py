@@ -43,3 +43,32 @@ def test_blender_imports_avatar_glb(tmp_path, empty_scene):
             np.testing.assert_allclose(np.abs(q @ anim.rotations[frame, j]), 1.0, atol=1e-5)
         location = np.array(armature.pose.bones["root"].location)
         np.testing.assert_allclose(location, anim.translations[frame, 0], atol=1e-5)
+
+
+def test_blender_imports_a_real_walking_human(tmp_path, empty_scene, model):
+    import bpy
+
+    import avatar
+
+    human = avatar.Human({"gender": 0.2, "age": 0.3}, model=model)
+    walk = avatar.walk(human.skeleton, seconds=0.5, fps=24)
+    path = avatar.save(human, tmp_path / "walker.glb", walk, expressions=True)
+    bpy.ops.import_scene.gltf(filepath=str(path))
+
+    body = bpy.data.objects["body"]
+    assert len(body.data.vertices) == len(gltf.split_vertices(human.parts()[0].mesh)[0])
+    assert (
+        len(body.data.shape_keys.key_blocks) == 53 and "jawOpen" in body.data.shape_keys.key_blocks
+    )
+    image = body.data.materials[0].node_tree.nodes["Image Texture"].image
+    assert tuple(image.size) == (1024, 1024)  # the procedural skin came along
+    armature = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    sk = human.skeleton
+    assert len(armature.data.bones) == len(sk.names)
+    rest = np.array([np.array(armature.data.bones[n].matrix_local) for n in sk.names])
+    np.testing.assert_allclose(rest, sk.rest, atol=1e-4)
+    (action,) = bpy.data.actions
+    assert tuple(action.frame_range) == (0.0, walk.frames - 1)  # 24 fps file, 24 fps scene
+    bpy.context.scene.frame_set(6)
+    pose = np.array([np.array(armature.pose.bones[n].rotation_quaternion) for n in sk.names])
+    np.testing.assert_allclose(np.abs(np.sum(pose * walk.rotations[6], axis=1)), 1.0, atol=1e-5)
