@@ -154,7 +154,7 @@ def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: b
         POSITION=packer.accessor(positions, acc.ARRAY_BUFFER, bounds=True),
         NORMAL=packer.accessor(normals, acc.ARRAY_BUFFER),
     )
-    if uv_index is not None:
+    if uv_index is not None and mesh.uvs is not None:
         uv = mesh.uvs[uv_index].astype(np.float32)
         uv[:, 1] = 1.0 - uv[:, 1]  # glTF's UV origin is the image's top-left corner
         attributes.TEXCOORD_0 = packer.accessor(uv, acc.ARRAY_BUFFER)
@@ -444,7 +444,7 @@ def _read_material(gltf, buffers, index: int | None) -> Material | None:
     rough = image(pbr.metallicRoughnessTexture)
     return Material(
         name=m.name or f"material_{index}",
-        base_color=tuple(float(c) for c in (pbr.baseColorFactor or (1, 1, 1, 1))),
+        base_color=_rgba(pbr.baseColorFactor),
         base_color_texture=image(pbr.baseColorTexture),
         normal_texture=_rgb(image(m.normalTexture)),
         normal_scale=float(m.normalTexture.scale or 1.0) if m.normalTexture else 1.0,
@@ -471,6 +471,11 @@ def _read_texture(gltf, buffers, texture_index: int) -> np.ndarray:
         raise ValueError(f"external image files are not read ({img.uri})")
     pixels = jpeg.decode(data) if data[:2] == b"\xff\xd8" else png.decode(data)
     return pixels if pixels.ndim == 3 else np.repeat(pixels[..., None], 3, axis=2)
+
+
+def _rgba(factor) -> tuple[float, float, float, float]:
+    r, g_, b, a = (float(c) for c in (factor or (1.0, 1.0, 1.0, 1.0)))
+    return (r, g_, b, a)
 
 
 def _rgb(image: np.ndarray | None) -> np.ndarray | None:

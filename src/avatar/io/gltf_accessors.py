@@ -14,7 +14,7 @@ import numpy as np
 import pygltflib as g
 
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
-COMPONENT = {  # glTF componentType -> numpy dtype (little-endian)
+COMPONENT: dict[int, np.dtype] = {  # glTF componentType -> numpy dtype (little-endian)
     5120: np.dtype("<i1"), 5121: np.dtype("<u1"), 5122: np.dtype("<i2"),
     5123: np.dtype("<u2"), 5125: np.dtype("<u4"), 5126: np.dtype("<f4"),
 }  # fmt: skip
