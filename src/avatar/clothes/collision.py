@@ -80,12 +80,16 @@ class SurfaceQuery:
     closest: (N, 3) float32 closest points on the surface.
     normal: (N, 3) float32 unit outward normals there.
     vertex: (N,) int32 the nearest body vertex (for per-vertex bookkeeping like layers).
+    triangle: (N,) int32 the triangle (index into ``BodySurface.triangles``) holding the
+        closest point, and bary (N, 3) float32 its barycentric weights there.
     """
 
     distance: np.ndarray
     closest: np.ndarray
     normal: np.ndarray
     vertex: np.ndarray
+    triangle: np.ndarray | None = None
+    bary: np.ndarray | None = None
 
 
 def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -153,7 +157,8 @@ def query(
         tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
     if normals is None:
         normals = surface.normals(x)
-    _, near = tree.query(p, k=k, workers=-1)
+    # Threads only pay off for big batches (a posed frame checks a few points).
+    _, near = tree.query(p, k=k, workers=-1 if len(p) > 20000 else 1)
     near = near.reshape(len(p), k)
     cand = surface.rings[near].reshape(len(p), -1)  # (N, C)
     tri = surface.triangles[cand]  # (N, C, 3)
@@ -164,6 +169,7 @@ def query(
     best = np.argmin(np.einsum("ncd,ncd->nc", pc - close, pc - close), axis=1)
     rows = np.arange(len(p))
     bary, tri_best, close = bary[rows, best], tri[rows, best], close[rows, best]
+    tri_index = cand[rows, best]
     n = np.einsum("nj,njd->nd", bary, normals[tri_best])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
     gap = p - close
@@ -173,6 +179,37 @@ def query(
         closest=close.astype(np.float32),
         normal=n.astype(np.float32),
         vertex=near[:, 0].astype(np.int32),
+        triangle=tri_index.astype(np.int32),
+        bary=bary.astype(np.float32),
+    )
+
+
+def anchored(
+    body_vertices: np.ndarray,
+    normals: np.ndarray,
+    surface: BodySurface,
+    points: np.ndarray,
+    triangle: np.ndarray,
+    bary: np.ndarray,
+) -> SurfaceQuery:
+    """Signed distances of points (N, 3) to known surface anchors (a triangle and barycentric
+    weights per point, e.g. the closest points found in the rest pose): no search, O(N).
+
+    In a skinned pose the anchor moves with the skin under the point, which is where its
+    closest point stays unless another body part comes close; callers that need those
+    contacts too use ``query``.
+    """
+    tri = surface.triangles[triangle]  # (N, 3)
+    close = np.einsum("nj,njd->nd", bary, body_vertices[tri])
+    n = np.einsum("nj,njd->nd", bary, normals[tri])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+    return SurfaceQuery(
+        distance=_dot(points - close, n).astype(np.float32),
+        closest=close.astype(np.float32),
+        normal=n.astype(np.float32),
+        vertex=tri[:, 0],
+        triangle=triangle,
+        bary=bary,
     )
 
 

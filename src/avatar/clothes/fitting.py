@@ -28,6 +28,9 @@ from avatar.rig.skinning import SkinWeights, linear_blend
 BODY_VERTEX_COUNT = 13380  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
+REMOTE_REACH = 0.03  # m; intrusions of another part deeper than about this are not sought
+FOLD = 0.3  # cosine between anchor and nearest-skin normals below which the skin folded
+REMOTE = 0.02  # m at rest between a point's anchor and its nearest skin: another body part
 FLOOR_REACH = 0.04  # m; garment parts further out (loose hems, hair ends) define no layer
 
 
@@ -119,6 +122,7 @@ class Pose:
         # k=4 candidate rings: one nearest vertex can miss the closest triangle where the
         # body folds (armpits, crotch), leaving points inside that a finer query finds.
         q = self.query(points, k=4)
+        need = np.float32(garment.clearance)
         for _ in range(iterations):
             need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
             if np.all(q.distance >= need - 1e-5):
@@ -126,6 +130,7 @@ class Pose:
             points = collision.push_out(points, q, need)
             q = self.query(points, k=4)
         self._raise_floor(q, garment.thickness)
+        self.last_need = np.broadcast_to(need, q.distance.shape).astype(np.float32)
         return points, q
 
     def _floor_at(self, vertex: np.ndarray) -> np.ndarray:
@@ -179,6 +184,11 @@ class Outfit:
     surface: collision.BodySurface
     rest_surfaces: list[np.ndarray]  # (N, 3) resolved bound surface per garment
     surface_weights: list[SkinWeights]
+    # Per colliding garment: the rest-pose closest triangle, its barycentrics, the clearance
+    # each vertex must keep (skin clearance or the layer below plus a gap), and the nearest
+    # skin vertex at rest.
+    anchors: list[tuple[np.ndarray, ...] | None] = field(default_factory=list)
+    rest_body: np.ndarray | None = None  # (13380, 3) skin at rest, to tell remote contacts
 
     # An Outfit reads as the list of its FittedGarments.
     def __iter__(self):
@@ -190,11 +200,18 @@ class Outfit:
     def __getitem__(self, i: int) -> FittedGarment:
         return self.garments[i]
 
-    def frame(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
+    def frame(
+        self, body_posed: np.ndarray, matrices: np.ndarray, exact: bool = False
+    ) -> list[np.ndarray]:
         """Garment vertices (M_i, 3) for one posed frame.
 
         body_posed: (V, 3) the body skinned with ``matrices`` (J, 4, 4) skinning matrices.
+        exact: search the whole body for every vertex (finds contacts with other body parts,
+            ~10x slower); by default each vertex keeps its clearance above the skin it was
+            closest to at rest, which moves with it (real time).
         """
+        if not exact and len(self.anchors) == len(self.garments):
+            return self._frame_anchored(body_posed, matrices)
         pose = Pose(self.surface, body_posed)
         out = []
         for g, rest, w in zip(self.garments, self.rest_surfaces, self.surface_weights, strict=True):
@@ -206,11 +223,83 @@ class Outfit:
             out.append(_shell_frame(g, points, q))
         return out
 
+    def _frame_anchored(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
+        x = np.asarray(body_posed[:BODY_VERTEX_COUNT], dtype=np.float32)
+        normals = self.surface.normals(x)
+        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
+        out = []
+        for g, rest, w, anchor in zip(
+            self.garments, self.rest_surfaces, self.surface_weights, self.anchors, strict=True
+        ):
+            points = linear_blend(rest, w, matrices)
+            if anchor is None:
+                out.append(points)
+                continue
+            q = collision.anchored(x, normals, self.surface, points, anchor[0], anchor[1])
+            points = _shell_frame(g, collision.push_out(points, q, anchor[2]), q)
+            facing = q.normal
+            if len(anchor) > 4:  # the outer layer keeps clear of the skin it is closest to
+                n = len(anchor[2])
+                qo = collision.anchored(x, normals, self.surface, points[n:], anchor[4], anchor[5])
+                points[n:] = collision.push_out(points[n:], qo, anchor[6])
+                facing = np.concatenate([q.normal, qo.normal])
+            # Both shell layers: where the body folds, the outer one can reach the next part.
+            need, near = anchor[2], anchor[3]
+            if len(anchor) > 4:
+                need, near = np.concatenate([need, need]), np.concatenate([near, anchor[7]])
+            out.append(self._remote_contacts(x, normals, tree, points, need, near, facing))
+        return out
+
+    def _remote_contacts(self, x, normals, tree, points, need, rest_near, facing) -> np.ndarray:
+        """Push points out of body parts other than the skin they are anchored to (an arm
+        swinging into a shirt's side, one thigh into the other trouser leg). Such a point's
+        nearest skin vertex now lies far, at rest, from its nearest one at rest, or faces
+        another way than its anchor (a fold closing, as in the crotch); only those few, and
+        only when close to the skin, get the exact search."""
+        dist, near = tree.query(points, k=1, distance_upper_bound=REMOTE_REACH)
+        close = np.isfinite(dist)
+        near = np.where(close, near, 0)
+        apart = np.linalg.norm(self.rest_body[near] - self.rest_body[rest_near], axis=1)
+        turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
+        remote = np.flatnonzero(close & ((apart > REMOTE) | turned))
+        if len(remote) == 0:
+            return points
+        exact = collision.query(x, self.surface, points[remote], k=4, tree=tree, normals=normals)
+        points = points.copy()
+        points[remote] = collision.push_out(points[remote], exact, need[remote])
+        return points
+
 
 def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
     if g.garment.shell is None or q is None:
         return points
     return extrude(points, q.normal, g.garment.thickness)
+
+
+def outward(garment: Garment, points: np.ndarray, body_normal: np.ndarray) -> np.ndarray:
+    """(N, 3) the garment surface's own unit normals, turned to the body's outside.
+
+    The shell grows along these, not along the body normal: where the body folds (the
+    crotch, an armpit) the body normal points into the neighbouring part, the cloth's not.
+    """
+    n = garment.topology.normals(points)
+    flip = np.einsum("nd,nd->n", n, body_normal) < 0
+    n[flip] *= -1
+    return n
+
+
+def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple | None:
+    """Rest-pose anchors of a garment for posed frames (see ``Outfit.anchors``); a shell's
+    outer layer gets its own (triangle, barycentrics, clearance)."""
+    if q is None:
+        return None
+    inner = (q.triangle, q.bary, pose.last_need, q.vertex)
+    n = len(q.distance)
+    if len(mesh.vertices) == n:
+        return inner
+    qo = pose.query(mesh.vertices[n:], k=4)
+    keep = np.minimum(qo.distance, pose.last_need + np.float32(garment.thickness))
+    return (*inner, qo.triangle, qo.bary, np.maximum(keep, 0).astype(np.float32), qo.vertex)
 
 
 def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
@@ -225,7 +314,7 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
     pose = Pose(surface, vertices)
     if bone_names is None and hasattr(human, "skeleton"):
         bone_names = human.skeleton.names
-    fitted, rests, ws = [], [], []
+    fitted, rests, ws, anchors = [], [], [], []
     for garment in sorted(garments, key=lambda g: g.z_depth):
         inner, q = fit_garment(pose, garment, vertices)
         w = garment_weights(garment, human.weights, bone_names)
@@ -247,4 +336,5 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
         )
         rests.append(inner)
         ws.append(w)
-    return Outfit(fitted, surface, rests, ws)
+        anchors.append(_anchors(pose, garment, q, mesh))
+    return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
