@@ -11,7 +11,7 @@ so a jacket stays over a shirt and a shirt over its wearer, frame after frame.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -28,10 +28,12 @@ from avatar.rig.skinning import SkinWeights, linear_blend
 BODY_VERTEX_COUNT = 13380  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
-REMOTE_REACH = 0.03  # m; intrusions of another part deeper than about this are not sought
+REMOTE_REACH = 0.06  # m; points further than this from every skin vertex are not checked
 FOLD = 0.3  # cosine between anchor and nearest-skin normals below which the skin folded
+PLANE_SLACK = 0.002  # m the tangent-plane estimate may fall short before it is checked
 REMOTE = 0.02  # m at rest between a point's anchor and its nearest skin: another body part
 FLOOR_REACH = 0.04  # m; garment parts further out (loose hems, hair ends) define no layer
+NEAR_BAND = 0.03  # m; points closer to the skin than this get the finer (4-ring) query
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +63,13 @@ class Garment:
     tags: tuple[str, ...] = ()
     source: str = "builtin"
     licence: str = ""
+
+    @cached_property
+    def anchor_cache(self) -> dict:
+        """Closest skin triangles of the garment's layers, found once by the exact search on
+        the first body it is fitted to; the body's topology never changes, so later fits
+        and frames measure against the same triangles in O(N) (``collision.anchored``)."""
+        return {}
 
     @cached_property
     def shell(self) -> Shell | None:
@@ -114,23 +123,52 @@ class Pose:
             self.vertices, self.surface, points, k=k, tree=self.tree, normals=self.normals
         )
 
+    def query_near(self, points: np.ndarray) -> collision.SurfaceQuery:
+        """Closest skin of points: one vertex ring each, four rings near the skin.
+
+        One nearest vertex can miss the closest triangle where the body folds (armpits,
+        crotch); that only matters for points close to the skin, which get four rings.
+        """
+        q = self.query(points, k=1)
+        close = np.flatnonzero(np.abs(q.distance) < NEAR_BAND)
+        return _put(q, close, self.query(points[close], k=4)) if len(close) else q
+
     def resolve(self, points: np.ndarray, garment: Garment, iterations: int = 6):
         """Push a garment's bound surface (N, 3) out of the body and the layers below.
 
         Returns (points (N, 3) float32, query at the final positions).
         """
-        # k=4 candidate rings: one nearest vertex can miss the closest triangle where the
-        # body folds (armpits, crotch), leaving points inside that a finer query finds.
-        q = self.query(points, k=4)
+        q = self.query_near(points)
         need = np.float32(garment.clearance)
         for _ in range(iterations):
             need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
-            if np.all(q.distance >= need - 1e-5):
+            short = np.flatnonzero(q.distance < need - 1e-5)
+            if len(short) == 0:
                 break
-            points = collision.push_out(points, q, need)
-            q = self.query(points, k=4)
+            # Only the points that moved need a new query.
+            points = points.copy()
+            points[short] = collision.push_out(points[short], _take(q, short), need[short])
+            q = _put(q, short, self.query(points[short], k=4))
         self._raise_floor(q, garment.thickness)
         self.last_need = np.broadcast_to(need, q.distance.shape).astype(np.float32)
+        return points, q
+
+    def resolve_anchored(self, points: np.ndarray, garment: Garment):
+        """``resolve`` against the garment's cached anchors: O(N) plus an exact search for
+        the few points near another body part. Returns (points, query)."""
+        tri, bary, near = garment.anchor_cache["inner"]
+        q = collision.anchored(self.vertices, self.normals, self.surface, points, tri, bary)
+        need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
+        fitted = points
+        pushed = collision.push_out(points, q, need)
+        points = remote_contacts(self.surface, self.vertices, self.vertices, self.normals,
+                                 self.tree, pushed, need, near, q.normal, 4)  # fmt: skip
+        moved = np.flatnonzero(np.any(points != pushed, axis=1))
+        if len(moved) and np.any(self.query(points[moved], k=4).distance < 0):
+            return self.resolve(fitted, garment)  # squeezed between parts: the full search
+        q = collision.anchored(self.vertices, self.normals, self.surface, points, tri, bary)
+        self._raise_floor(q, garment.thickness)
+        self.last_need = need.astype(np.float32)
         return points, q
 
     def _floor_at(self, vertex: np.ndarray) -> np.ndarray:
@@ -141,6 +179,23 @@ class Pose:
         top = q.distance + np.float32(thickness)
         near = q.distance < FLOOR_REACH
         np.maximum.at(self.floor, q.vertex[near], top[near])
+
+
+_QUERY_FIELDS = ("distance", "closest", "normal", "vertex", "triangle", "bary")
+
+
+def _take(q: collision.SurfaceQuery, index: np.ndarray) -> collision.SurfaceQuery:
+    return collision.SurfaceQuery(*(getattr(q, f)[index] for f in _QUERY_FIELDS))
+
+
+def _put(q, index: np.ndarray, part) -> collision.SurfaceQuery:
+    """q with rows ``index`` replaced by ``part``'s."""
+    fields = []
+    for f in _QUERY_FIELDS:
+        whole = getattr(q, f).copy()
+        whole[index] = getattr(part, f)
+        fields.append(whole)
+    return collision.SurfaceQuery(*fields)
 
 
 def _body_faces(human) -> np.ndarray:
@@ -173,7 +228,11 @@ def fit_garment(
     points = fit(garment.binding, body_vertices)
     if not garment.collide:
         return points, None
-    return pose.resolve(points, garment)
+    if "inner" in garment.anchor_cache:
+        return pose.resolve_anchored(points, garment)
+    points, q = pose.resolve(points, garment)
+    garment.anchor_cache["inner"] = (q.triangle, q.bary, q.vertex)
+    return points, q
 
 
 @dataclass(eq=False)
@@ -247,27 +306,36 @@ class Outfit:
             need, near = anchor[2], anchor[3]
             if len(anchor) > 4:
                 need, near = np.concatenate([need, need]), np.concatenate([near, anchor[7]])
-            out.append(self._remote_contacts(x, normals, tree, points, need, near, facing))
+            out.append(remote_contacts(self.surface, self.rest_body, x, normals, tree, points,
+                                       need, near, facing))  # fmt: skip
         return out
 
-    def _remote_contacts(self, x, normals, tree, points, need, rest_near, facing) -> np.ndarray:
-        """Push points out of body parts other than the skin they are anchored to (an arm
-        swinging into a shirt's side, one thigh into the other trouser leg). Such a point's
-        nearest skin vertex now lies far, at rest, from its nearest one at rest, or faces
-        another way than its anchor (a fold closing, as in the crotch); only those few, and
-        only when close to the skin, get the exact search."""
-        dist, near = tree.query(points, k=1, distance_upper_bound=REMOTE_REACH)
-        close = np.isfinite(dist)
-        near = np.where(close, near, 0)
-        apart = np.linalg.norm(self.rest_body[near] - self.rest_body[rest_near], axis=1)
-        turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
-        remote = np.flatnonzero(close & ((apart > REMOTE) | turned))
-        if len(remote) == 0:
-            return points
-        exact = collision.query(x, self.surface, points[remote], k=4, tree=tree, normals=normals)
-        points = points.copy()
-        points[remote] = collision.push_out(points[remote], exact, need[remote])
+
+def remote_contacts(surface, reference, x, normals, tree, points, need, rest_near, facing,
+                    iterations: int = 1):  # fmt: skip
+    """Push points out of body parts other than the skin they are anchored to (an arm
+    swinging into a shirt's side, one thigh into the other trouser leg). Such a point's
+    nearest skin vertex now lies far, at rest, from its nearest one at rest, or faces
+    another way than its anchor (a fold closing, as in the crotch); only those few, and
+    only when close to the skin, get the exact search."""
+    dist, near = tree.query(points, k=1, distance_upper_bound=REMOTE_REACH)
+    close = np.isfinite(dist)
+    near = np.where(close, near, 0)
+    apart = np.linalg.norm(reference[near] - reference[rest_near], axis=1)
+    turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
+    # The nearest vertex's tangent plane is a second, independent opinion: where it says
+    # "too close" although the anchor did not, look properly.
+    plane = np.einsum("nd,nd->n", points - x[near], normals[near]) < need - PLANE_SLACK
+    remote = np.flatnonzero(close & ((apart > REMOTE) | turned | plane))
+    if len(remote) == 0:
         return points
+    points = points.copy()
+    for _ in range(iterations):  # between two parts one push can land in the other
+        exact = collision.query(x, surface, points[remote], k=4, tree=tree, normals=normals)
+        if np.all(exact.distance >= need[remote] - 1e-5):
+            break
+        points[remote] = collision.push_out(points[remote], exact, need[remote])
+    return points
 
 
 def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
@@ -293,13 +361,36 @@ def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple | None:
     outer layer gets its own (triangle, barycentrics, clearance)."""
     if q is None:
         return None
-    inner = (q.triangle, q.bary, pose.last_need, q.vertex)
+    tri, bary, near = garment.anchor_cache["inner"]
+    inner = (tri, bary, pose.last_need, near)
     n = len(q.distance)
     if len(mesh.vertices) == n:
         return inner
-    qo = pose.query(mesh.vertices[n:], k=4)
+    outer = mesh.vertices[n:]
+    if "outer" not in garment.anchor_cache:
+        qo = pose.query_near(outer)
+        garment.anchor_cache["outer"] = (qo.triangle, qo.bary, qo.vertex)
+    tri_o, bary_o, near_o = garment.anchor_cache["outer"]
+    qo = collision.anchored(pose.vertices, pose.normals, pose.surface, outer, tri_o, bary_o)
     keep = np.minimum(qo.distance, pose.last_need + np.float32(garment.thickness))
-    return (*inner, qo.triangle, qo.bary, np.maximum(keep, 0).astype(np.float32), qo.vertex)
+    return (*inner, tri_o, bary_o, np.maximum(keep, 0).astype(np.float32), near_o)
+
+
+def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple) -> Mesh:
+    """A shell's outer layer, grown along the body normal, checked against the whole body
+    (in a fold it can reach the skin opposite)."""
+    n = len(anchor[2])
+    outer = mesh.vertices[n:]
+    qo = collision.anchored(pose.vertices, pose.normals, pose.surface, outer, anchor[4], anchor[5])
+    outer = fixed = collision.push_out(outer, qo, anchor[6])
+    outer = remote_contacts(pose.surface, pose.vertices, pose.vertices, pose.normals, pose.tree,
+                            outer, anchor[6], anchor[7], qo.normal, iterations=4)  # fmt: skip
+    # Squeezed between two body parts there may be no room for the shell: it thins there.
+    moved = np.flatnonzero(np.any(outer != fixed, axis=1))
+    if len(moved):
+        stuck = moved[pose.query(outer[moved], k=4).distance < 0]
+        outer[stuck] = mesh.vertices[stuck]
+    return mesh.with_vertices(np.concatenate([mesh.vertices[:n], outer]))
 
 
 def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
@@ -337,4 +428,7 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
         rests.append(inner)
         ws.append(w)
         anchors.append(_anchors(pose, garment, q, mesh))
+        if anchors[-1] is not None and len(anchors[-1]) > 4:
+            mesh = _check_outer(pose, mesh, anchors[-1])
+            fitted[-1] = replace(fitted[-1], mesh=mesh)
     return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
