@@ -33,6 +33,7 @@ FOLD = 0.3  # cosine between anchor and nearest-skin normals below which the ski
 PLANE_SLACK = 0.002  # m the tangent-plane estimate may fall short before it is checked
 REMOTE = 0.02  # m at rest between a point's anchor and its nearest skin: another body part
 FLOOR_REACH = 0.04  # m; garment parts further out (loose hems, hair ends) define no layer
+FRAME_INFLUENCES = 4  # bones per vertex when skinning garments frame by frame (speed)
 NEAR_BAND = 0.03  # m; points closer to the skin than this get the finer (4-ring) query
 
 
@@ -426,7 +427,7 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
             )
         )
         rests.append(inner)
-        ws.append(w)
+        ws.append(w.limit(FRAME_INFLUENCES))
         anchors.append(_anchors(pose, garment, q, mesh))
         if anchors[-1] is not None and len(anchors[-1]) > 4:
             mesh = _check_outer(pose, mesh, anchors[-1])
