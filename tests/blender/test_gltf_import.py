@@ -19,6 +19,8 @@ def test_blender_imports_avatar_glb(tmp_path, empty_scene):
     parts, sk, anim = scene()
     path = tmp_path / "limb.glb"
     gltf.write(path, parts, sk, {"bend": anim})
+    # Blender's importer converts seconds to frames at the scene's rate: match the clip's.
+    bpy.context.scene.render.fps, bpy.context.scene.render.fps_base = round(anim.fps), 1.0
     bpy.ops.import_scene.gltf(filepath=str(path))
 
     limb = bpy.data.objects["limb"]
@@ -53,6 +55,7 @@ def test_blender_imports_a_real_walking_human(tmp_path, empty_scene, model):
     human = avatar.Human({"gender": 0.2, "age": 0.3}, model=model)
     walk = avatar.walk(human.skeleton, seconds=0.5, fps=24)
     path = avatar.save(human, tmp_path / "walker.glb", walk, expressions=True)
+    bpy.context.scene.render.fps, bpy.context.scene.render.fps_base = 24, 1.0
     bpy.ops.import_scene.gltf(filepath=str(path))
 
     body = bpy.data.objects["body"]
