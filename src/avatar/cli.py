@@ -97,6 +97,11 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
 
     add_motion_arguments(p)
     p.add_argument(
+        "--hide-covered",
+        action="store_true",
+        help="glTF: leave out skin that garments cover entirely (default: keep it)",
+    )
+    p.add_argument(
         "--expressions",
         action="store_true",
         help="glTF: include the 52 ARKit face units as morph targets",
@@ -174,7 +179,7 @@ def run_create(args: argparse.Namespace) -> int:
         human = Human(solved, human.recipe.rig, model, human.recipe)
     human = _dress(human, args.wear)
     animation = _animation(human, args)
-    path = save(human, args.output, animation, args.expressions)
+    path = save(human, args.output, animation, args.expressions, args.hide_covered)
     log.info("wrote %s", path)
     if args.render:
         from avatar.blender.picture import render_human

@@ -11,13 +11,13 @@ from avatar.human import Human
 from avatar.rig.skeleton import Animation
 
 
-def _mhm(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
+def _mhm(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.io import mhm
 
     mhm.write(path, human.to_mhm(path.stem))
 
 
-def _obj(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
+def _obj(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.io import obj
 
     mesh = human.mesh
@@ -28,15 +28,15 @@ def _obj(human: Human, path: Path, animation: Animation | None, expressions: boo
     obj.write(path, mesh)
 
 
-def _gltf(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
+def _gltf(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.io import gltf
 
     gltf.write(
-        path, human.parts(expressions), human.skeleton, [animation] if animation is not None else []
+        path, human.parts(**options), human.skeleton, [animation] if animation is not None else []
     )
 
 
-def _blender(human: Human, path: Path, animation: Animation | None, expressions: bool) -> None:
+def _blender(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.blender import export, scene
 
     scene.clear_scene()
@@ -44,7 +44,7 @@ def _blender(human: Human, path: Path, animation: Animation | None, expressions:
     export.export(path, [built.root, *built.parts])
 
 
-WRITERS: dict[str, Callable[[Human, Path, Animation | None, bool], None]] = {
+WRITERS: dict[str, Callable[[Human, Path, Animation | None, dict], None]] = {
     ".mhm": _mhm,
     ".obj": _obj,
     ".glb": _gltf,
@@ -62,10 +62,12 @@ def save(
     path: str | os.PathLike[str],
     animation: Animation | None = None,
     expressions: bool = False,
+    hide_covered: bool = False,
 ) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
     expressions: include the 52 ARKit face units as morph targets (glTF only).
+    hide_covered: leave out skin that garments cover entirely (glTF; default: keep it).
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
     (the skin mesh), .mhm (MakeHuman character file), .fbx/.usd/.blend (through Blender).
     """
@@ -74,5 +76,5 @@ def save(
     if writer is None:
         raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    writer(human, path, animation, expressions)
+    writer(human, path, animation, {"expressions": expressions, "hide_covered": hide_covered})
     return path

@@ -164,24 +164,49 @@ class Human:
         w = self.weights.subset(self.part_vertices(name))
         return w.indices, w.weights
 
-    def parts(self, expressions: bool = False) -> list:
+    def parts(self, expressions: bool = False, hide_covered: bool = False) -> list:
         """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
 
         expressions: attach the 52 ARKit face units to the body as morph targets.
+        hide_covered: drop body faces that the garments cover entirely (their
+            ``delete_verts``); by default the whole body is kept, e.g. for cloth simulation.
         """
         from avatar.part import MeshPart
 
         out = []
         for name in BODY_PART_GROUPS:
-            morphs = self.expression_morphs() if expressions and name == "body" else {}
-            part = MeshPart(
-                name, self.part(name), self.material(name), self.part_skin(name), morphs
-            )
-            out.append(part)
+            mesh, index = self.part(name), self.part_vertices(name)
+            if name == "body" and hide_covered and self.recipe.clothes:
+                mesh, index = self._uncovered_body()
+            morphs = self.expression_morphs(index) if expressions and name == "body" else {}
+            skin = self.weights.subset(index)
+            out.append(MeshPart(name, mesh, self.material(name), (skin.indices, skin.weights),
+                                morphs))  # fmt: skip
         if self.recipe.clothes:
             from avatar.clothes import library
 
             out += library.parts(self.outfit)
+        return out
+
+    def _uncovered_body(self) -> tuple[Mesh, np.ndarray]:
+        """The skin without faces every corner of which some garment covers."""
+        base = self.model.base
+        covered = np.zeros(len(self.vertices), dtype=bool)
+        for g in self.outfit.garments:
+            covered[g.delete_verts] = True
+        faces = base.face_groups["body"]
+        keep = np.sort(faces[~covered[base.faces[faces]].all(axis=1)])
+        return base.with_vertices(self.vertices).subset(keep), np.unique(base.faces[keep])
+
+    def expression_morphs(self, vertices: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """ARKit face unit name -> (n, 3) float32 deltas (metres) of ``vertices``
+        (default: the skin's 13,380 vertices)."""
+        index = self.part_vertices("body") if vertices is None else vertices
+        out = {}
+        for name in self.model.target_names:
+            if name.startswith("faceunits/"):
+                delta = self.model.displacement({"expression/" + name[10:]: 1.0})
+                out[name[10:]] = delta[index]
         return out
 
     @cached_property
@@ -196,16 +221,6 @@ class Human:
         clothes = tuple(dict.fromkeys(self.recipe.clothes + tuple(str(g) for g in garments)))
         return Human(self.recipe.params, self.recipe.rig, self.model,
                      replace(self.recipe, clothes=clothes))  # fmt: skip
-
-    def expression_morphs(self) -> dict[str, np.ndarray]:
-        """ARKit face unit name -> (13380, 3) float32 body-vertex deltas (metres)."""
-        body = self.part_vertices("body")
-        out = {}
-        for name in self.model.target_names:
-            if name.startswith("faceunits/"):
-                delta = self.model.displacement({"expression/" + name[10:]: 1.0})
-                out[name[10:]] = delta[body]
-        return out
 
     def material(self, part: str):
         """The generated material of a body part (procedural skin or eye)."""

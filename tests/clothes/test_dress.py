@@ -99,3 +99,12 @@ def test_unknown_garment_lists_close_matches():
 
     with pytest.raises(ParameterError, match="tshirt"):
         library.load_garment("tshrt")
+
+
+def test_covered_skin_is_kept_unless_hidden(model):
+    human = Human({}, model=model).dressed("tshirt", "jeans")
+    kept = human.parts()[0]
+    hidden = human.parts(hide_covered=True)[0]
+    assert len(kept.mesh.vertices) == 13380
+    assert 0 < len(hidden.mesh.vertices) < 13380
+    assert hidden.skin[0].shape[0] == len(hidden.mesh.vertices)
