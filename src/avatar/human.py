@@ -159,11 +159,6 @@ class Human:
         return skin(self.vertices, self.weights, mats)
 
     # ------------------------------------------------------------------ export
-    def part_skin(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """Skin weights ``(indices (V, K), weights (V, K))`` of a part's vertices."""
-        w = self.weights.subset(self.part_vertices(name))
-        return w.indices, w.weights
-
     def parts(self, expressions: bool = False, hide_covered: bool = False) -> list:
         """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
 
