@@ -27,7 +27,7 @@ class BodySurface:
     faces: (F, 3|4) int32 polygon faces (for vertex normals).
     triangles: (T, 3) int32 triangles (quads split on their 0-2 diagonal).
     rings: (V, R) int32 triangles around each vertex, padded by repeating the first.
-    incidence: (V, T) sparse vertex-triangle incidence (sums triangle normals per vertex).
+    incidence: (V, F) sparse vertex-face incidence (sums face area vectors per vertex).
     """
 
     faces: np.ndarray
@@ -38,11 +38,20 @@ class BodySurface:
     def normals(self, vertices: np.ndarray) -> np.ndarray:
         """(V, 3) float32 unit area-weighted vertex normals of the body posed at vertices."""
         x = np.asarray(vertices, dtype=np.float32)
-        t = self.triangles
-        fn = np.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]])
+        f = self.faces
+        # A polygon's area vector from its diagonals (for a quad this is exactly the sum of
+        # its two triangles'): half the gathers of a per-triangle cross product.
+        if f.shape[1] == 4:
+            a, b = x[f[:, 2]] - x[f[:, 0]], x[f[:, 3]] - x[f[:, 1]]
+        else:
+            a, b = x[f[:, 1]] - x[f[:, 0]], x[f[:, 2]] - x[f[:, 0]]
+        fn = np.empty_like(a)
+        fn[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+        fn[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+        fn[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
         n = self.incidence @ fn
-        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-        return n.astype(np.float32)
+        n /= np.maximum(np.sqrt(np.einsum("vd,vd->v", n, n))[:, None], 1e-12)
+        return n
 
 
 def body_surface(faces: np.ndarray) -> BodySurface:
@@ -66,8 +75,13 @@ def body_surface(faces: np.ndarray) -> BodySurface:
     rings[vert, slot] = tri
     first = np.where(rings[:, :1] >= 0, rings[:, :1], 0)
     rings = np.where(rings >= 0, rings, first)
+    corner = faces.ravel()
     incidence = csr_matrix(
-        (np.ones(len(vert), np.float32), (vert, tri)), shape=(len(count), len(tris))
+        (
+            np.ones(len(corner), np.float32),
+            (corner, np.repeat(np.arange(len(faces)), faces.shape[1])),
+        ),
+        shape=(len(count), len(faces)),
     )
     return BodySurface(faces, tris.astype(np.int32), rings, incidence)
 
