@@ -130,16 +130,9 @@ class Human:
 
     @cached_property
     def weights(self) -> SkinWeights:
-        """Skin weights of all 19,158 vertices over ``skeleton``'s bones."""
-        bones, offsets, vertex, weight = self.model.assets.weights(self.recipe.rig)
-        index = {b: i for i, b in enumerate(self.skeleton.names)}
-        counts = np.diff(offsets)
-        bone_ids = np.array([index.get(b, -1) for b in bones])
-        bone_of_entry = np.repeat(bone_ids, counts)
-        keep = bone_of_entry >= 0  # weights of bones this rig lacks (none in shipped rigs)
-        return SkinWeights.from_lists(
-            len(self.vertices), bone_of_entry[keep], vertex[keep], weight[keep]
-        )
+        """Skin weights of all 19,158 vertices over ``skeleton``'s bones (shared by every
+        body of the rig: weights do not depend on the shape)."""
+        return self.model.skin_weights(self.recipe.rig, tuple(self.skeleton.names))
 
     def pose(self, name: str) -> Animation:
         """A named pose ("rest", "a-pose", "t-pose") for this rig."""

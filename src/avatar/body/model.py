@@ -27,6 +27,7 @@ from avatar.body import macros
 from avatar.body.modifiers import Modifier, modifiers_from_target_json
 from avatar.errors import ParameterError, unknown_name
 from avatar.mesh import Mesh
+from avatar.rig.skinning import SkinWeights
 
 log = logging.getLogger(__name__)
 
@@ -195,12 +196,27 @@ class BodyModel:
         )
         self._attributes: dict[str, np.ndarray] = {}
         self._flat_indices: dict[int, np.ndarray] = {}  # target id -> flat positions (lazy)
+        self._skin_weights: dict[tuple, SkinWeights] = {}  # (rig, bone names) -> weights
         self.macro_sum = MacroSum(self.macro_table, self._macro_dense, self._macro_spans())
 
     @classmethod
     def load(cls, data_dir: str | None = None) -> BodyModel:
         """The body model over the installed MakeHuman assets (compiled on first use)."""
         return cls(assets.load(data_dir))
+
+    def skin_weights(self, rig: str, bone_names: tuple[str, ...]) -> SkinWeights:
+        """Skin weights of all base-mesh vertices over a rig's bones (built once per rig)."""
+        key = (rig, bone_names)
+        if key not in self._skin_weights:
+            bones, offsets, vertex, weight = self.assets.weights(rig)
+            index = {b: i for i, b in enumerate(bone_names)}
+            bone_ids = np.array([index.get(b, -1) for b in bones])
+            bone_of_entry = np.repeat(bone_ids, np.diff(offsets))
+            keep = bone_of_entry >= 0  # weights of bones this rig lacks (none in shipped rigs)
+            self._skin_weights[key] = SkinWeights.from_lists(
+                len(self.base.vertices), bone_of_entry[keep], vertex[keep], weight[keep]
+            )
+        return self._skin_weights[key]
 
     # ------------------------------------------------------------------ parameters
     @cached_property

@@ -73,6 +73,12 @@ class Garment:
         return {}
 
     @cached_property
+    def weight_cache(self) -> list:
+        """The last (body weights, bone names, result) of ``garment_weights``: the body's
+        skin weights belong to the rig, not the shape, so every body of a rig reuses it."""
+        return []
+
+    @cached_property
     def shell(self) -> Shell | None:
         """The solidified topology (computed once), or None without thickness."""
         return solidify(self.mesh) if self.thickness > 0 else None
@@ -102,11 +108,19 @@ def _surface_cached(key: bytes, faces_shape: tuple[int, int]) -> collision.BodyS
     return collision.body_surface(faces)
 
 
+_LAST_SURFACE: list = []  # [(faces array, surface)]: skips hashing the same faces again
+
+
 def body_surface(faces: np.ndarray) -> collision.BodySurface:
     """The collision surface of the skin (faces of vertices < 13,380), cached by topology."""
+    if _LAST_SURFACE and _LAST_SURFACE[0][0] is faces:
+        return _LAST_SURFACE[0][1]
+    key = faces
     faces = np.asarray(faces, dtype=np.int32)
     skin = faces[(faces < BODY_VERTEX_COUNT).all(axis=1)]
-    return _surface_cached(np.ascontiguousarray(skin).tobytes(), skin.shape)
+    surface = _surface_cached(np.ascontiguousarray(skin).tobytes(), skin.shape)
+    _LAST_SURFACE[:] = [(key, surface)]  # holds the faces array: its id cannot be reused
+    return surface
 
 
 class Pose:
@@ -208,9 +222,16 @@ def _body_faces(human) -> np.ndarray:
 
 def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None) -> SkinWeights:
     """(N, K) skin weights of the garment's bound surface: its ``.mhw`` or the body's."""
-    if garment.bone_weights is not None and bone_names is not None:
-        return weights.from_file(garment.bone_weights, bone_names, len(garment.binding))
-    return weights.transfer(garment.binding, body_weights)
+    names = tuple(bone_names) if bone_names is not None else None
+    for cached_weights, cached_names, result in garment.weight_cache:
+        if cached_weights is body_weights and cached_names == names:
+            return result
+    if garment.bone_weights is not None and names is not None:
+        result = weights.from_file(garment.bone_weights, names, len(garment.binding))
+    else:
+        result = weights.transfer(garment.binding, body_weights)
+    garment.weight_cache[:] = [(body_weights, names, result)]  # holds body_weights: no id reuse
+    return result
 
 
 def _with_shell(garment: Garment, inner: np.ndarray, q, w: SkinWeights):
