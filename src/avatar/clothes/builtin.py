@@ -21,7 +21,6 @@ from avatar.clothes.authoring import (
     covered_skin,
     cut,
     join,
-    single_references,
 )
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
@@ -145,7 +144,7 @@ SPECS = [
     Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
     Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
-    Spec("eyelashes", "face", lambda b: join([single_references(b, g) for g in EYELASH_GROUPS]), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
+    Spec("eyelashes", "face", lambda b: hair.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
 ]  # fmt: skip
 
 EYELASH_GROUPS = (

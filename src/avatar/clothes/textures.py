@@ -1,8 +1,15 @@
 """Alpha-cut textures for hair, eyebrows and eyelashes (numpy, deterministic).
 
-Hair layout (see ``hair``): image rows 0..S/2 (v 1..0.5) are dense strands for scalp caps;
-rows S/2..S (v 0.5..0) are cards from the roots to the tips, each strand ending at its own
-random length so the tips thin out.
+Every texture is painted from individual strands: tapered strokes splatted with
+anti-aliased edges into an (S, S) coverage image, so alpha has opaque cores, soft edges and
+see-through gaps, and a colour map follows the same strands (dark roots, lighter tips).
+
+Layouts (UV v up, image row 0 at the top, ``material`` module convention):
+
+- hair: v in [0.5, 1] dense strands running along v for scalp shells (u around the head),
+  v in [0, 0.5] card strands from the roots (v = 0.5) to thinning tips (v = 0);
+- eyebrow: u from the inner end (0) to the tail (1) of one brow, v up across it;
+- eyelash: u along the lid, v from the lid margin (0) to the lash tips (1).
 """
 
 from __future__ import annotations
@@ -13,46 +20,153 @@ from avatar.clothes import fabrics
 from avatar.material import Material
 
 
-def strand_alpha(size: int, seed: int = 0) -> np.ndarray:
-    """(S, S) uint8 alpha: opaque upper half, strand ends in the lower half."""
-    rng = np.random.default_rng([seed, size])
-    cols = np.arange(size)
-    # Strand lengths vary smoothly across u (locks) plus per-column jitter.
-    locks = np.interp(cols, np.linspace(0, size, 17), rng.uniform(0.45, 1.0, 17))
-    length = np.clip(locks + rng.normal(0, 0.12, size), 0.15, 1.0)
-    t = (np.arange(size // 2) + 0.5) / (size // 2)  # 0 at the roots, 1 at the tips
-    card = (t[:, None] < length[None, :]).astype(np.float32)
-    card *= (rng.uniform(size=size) < 0.85)[None, :]  # some columns empty: see-through gaps
-    alpha = np.concatenate([np.ones((size - size // 2, size), np.float32), card])
-    return np.round(alpha * 255).astype(np.uint8)
+def stroke(
+    canvas: np.ndarray,
+    points: np.ndarray,
+    width: np.ndarray,
+    value: float = 1.0,
+    wrap: bool = False,
+) -> None:
+    """Splat one tapered strand into ``canvas`` (H, W) float32, in place (max-composited).
+
+    points: (P, 2) polyline in pixels (x = column, y = row); width: (P,) full width in
+    pixels at each point. Edges are anti-aliased over one pixel; with ``wrap`` columns
+    wrap around (tileable u), else what falls outside is dropped.
+    """
+    h, w = canvas.shape
+    pad = float(width.max()) / 2 + 1.5
+    lo = np.floor(points.min(0) - pad).astype(int)
+    hi = np.ceil(points.max(0) + pad).astype(int)
+    y0, y1 = max(lo[1], 0), min(hi[1], h)
+    if y1 <= y0:
+        return
+    ys, xs = np.mgrid[y0:y1, lo[0] : hi[0]]
+    pix = np.stack([xs, ys], -1).astype(np.float32) + 0.5  # (h, w, 2) pixel centres
+    best = np.full(xs.shape, np.inf, np.float32)
+    for a, b, wa, wb in zip(points[:-1], points[1:], width[:-1], width[1:], strict=True):
+        d = b - a
+        t = np.clip(((pix - a) @ d) / max(float(d @ d), 1e-9), 0, 1)
+        dist = np.linalg.norm(pix - (a + t[..., None] * d), axis=-1) - (wa + t * (wb - wa)) / 2
+        best = np.minimum(best, dist)
+    cover = np.clip(0.5 - best, 0, 1) * value
+    cols = xs[0] % w if wrap else xs[0]
+    inside = (cols >= 0) & (cols < w)
+    cols, cover = cols[inside], cover[:, inside]
+    rows = slice(y0, y1)
+    canvas[rows, cols] = np.maximum(canvas[rows, cols], cover)
+
+
+def _curve(start, direction, length, bend, samples: int = 5) -> np.ndarray:
+    """(samples, 2) points of a gently bending strand (bend: radians over its length)."""
+    t = np.linspace(0, 1, samples)
+    angle = np.arctan2(direction[1], direction[0]) + bend * t
+    step = length / (samples - 1)
+    xy = np.stack([np.cos(angle), np.sin(angle)], -1) * step
+    xy[0] = 0
+    return np.asarray(start, np.float32) + np.cumsum(xy, 0).astype(np.float32)
+
+
+def lash_alpha(size: int, seed: int = 0) -> np.ndarray:
+    """(S, S) uint8 alpha of eyelashes (layout in the module docstring): upper lashes over
+    v in [0.5, 1], lower ones (shorter, sparser) over [0, 0.5]; each half has a dense lash
+    line at its root and thin strands tapering to the tips, fanning out towards the corners.
+    A pixel spans about twice as much lid along u as across it along v; strands are drawn
+    steep so that they stand up from the lid after that stretch."""
+    rng = np.random.default_rng([seed, size, 11])
+    half = size // 2
+    canvas = np.zeros((size, size), np.float32)
+    for root_row, count, reach, density in (
+        (half - 1.0, 170, 1.0, 1.0),
+        (size - 1.0, 90, 0.55, 0.7),
+    ):
+        for i in range(count):
+            u = (i + rng.uniform(0.1, 0.9)) / count
+            middle = np.sin(np.pi * u)
+            if rng.uniform() > density * (0.35 + 0.65 * middle**0.5):
+                continue
+            length = half * reach * rng.uniform(0.6, 0.98) * (0.55 + 0.45 * middle)
+            fan = 0.45 * (u - 0.5) + rng.normal(0, 0.03)  # radians off straight up
+            direction = (np.sin(fan), -np.cos(fan))  # up the image (towards the tips)
+            points = _curve((u * size, root_row), direction, length, 0.15 * np.sign(fan))
+            width = np.linspace(0.011, 0.002, len(points)) * size
+            stroke(canvas, points, np.maximum(width, 0.7), rng.uniform(0.9, 1.0))
+        line = np.linspace(1, 0, max(size // 25, 2)) ** 1.2  # the lash line at the lid margin
+        rows = int(root_row) - np.arange(len(line))
+        canvas[rows] = np.maximum(canvas[rows], line[:, None])
+    return np.round(np.clip(canvas, 0, 1) * 255).astype(np.uint8)
+
+
+def brow_shape(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(centre line, half thickness) of an eyebrow in texture v at positions u (0 inner end,
+    1 tail): a tall rounded head, the arch peaking at two thirds, a thin descending tail."""
+    centre = (
+        0.42
+        + 0.18 * np.sin(np.pi / 2 * np.clip(u / 0.65, 0, 1))
+        - 0.45 * np.clip(u - 0.65, 0, 1) ** 1.3
+    )
+    half = 0.17 * (1 - 0.72 * u) * np.sqrt(np.clip(u / 0.05, 0, 1))
+    return centre, half * np.clip((1 - u) / 0.1, 0, 1) ** 0.6
 
 
 def brow_alpha(size: int, seed: int = 0) -> np.ndarray:
-    """(S, S) uint8 alpha of one eyebrow: a tapered band of slanted short strokes."""
+    """(S, S) uint8 alpha of one eyebrow: over a thousand short slanted hairs, upright at
+    the head and sweeping outward along the body; lower hairs grow up and out, upper ones
+    out and down, and the edges thin out instead of ending in a hard line."""
     rng = np.random.default_rng([seed, size, 7])
-    v, u = np.mgrid[0:size, 0:size] / size
-    v = 1 - v  # row 0 is the top
-    # Thick at the inner end (u = 0), thin at the outer end, arching slightly.
-    half = 0.28 * (1 - 0.65 * u) * (u > 0.02) * (u < 0.98)
-    band = np.abs(v - 0.5 - 0.08 * np.sin(np.pi * u)) < half
-    strokes = np.sin(2 * np.pi * (55 * u + 14 * v) + rng.uniform(0, 6)) > 0.1
-    return np.round(band * strokes * 230).astype(np.uint8)
+    canvas = np.zeros((size, size), np.float32)
+    u = rng.uniform(0.0, 1.0, 1600) ** 0.85
+    centre, half = brow_shape(u)
+    across = rng.uniform(-1.2, 1.2, len(u))  # -1 lower edge, +1 upper edge
+    v = centre + half * across
+    opacity = rng.uniform(0.75, 1.0, len(u)) * np.clip((1.25 - np.abs(across)) / 0.45, 0, 1)
+    keep = (half > 0.01) & (opacity > 0.05)
+    for ui, vi, ai, oi in zip(u[keep], v[keep], across[keep], opacity[keep], strict=True):
+        # Degrees from the +u axis: ~75 at the head, ~20 along the body, ~5 at the tail,
+        # steeper below the centre line and flatter (down) above it.
+        head = np.clip(ui / 0.25, 0, 1)
+        angle = 75 - 55 * head - 60 * np.clip(ui - 0.6, 0, 0.4) - 18 * head * ai
+        angle = np.radians(angle + rng.normal(0, 7))
+        direction = (np.cos(angle), -np.sin(angle))  # image rows run down
+        length = size * rng.uniform(0.06, 0.1) * (1 - 0.35 * ui)
+        start = ((0.03 + 0.85 * ui) * size, (1 - vi) * size)  # room for the tail's hairs
+        points = _curve(start, direction, length, rng.normal(-0.2, 0.1), samples=4)
+        width = np.linspace(0.006, 0.0015, len(points)) * size * (1 - 0.3 * ui)
+        stroke(canvas, points, np.maximum(width, 0.6), oi)
+    return np.round(np.clip(canvas, 0, 1) * 255).astype(np.uint8)
 
 
-def lash_alpha(size: int) -> np.ndarray:
-    """(S, S) uint8 alpha of fine lash strands (every other thin stripe)."""
-    u = np.arange(size) / size
-    stripes = (np.sin(2 * np.pi * 90 * u) > 0.2).astype(np.float32)
-    return np.round(np.tile(stripes, (size, 1)) * 255).astype(np.uint8)
+def strand_alpha(size: int, seed: int = 0) -> np.ndarray:
+    """(S, S) uint8 alpha of the hair layout (module docstring): dense strands over the
+    upper half, strands of varying length thinning to the tips over the lower half."""
+    rng = np.random.default_rng([seed, size])
+    half = size // 2
+    cols = np.arange(size)
+    # Strand lengths vary smoothly across u (locks) plus per-column jitter.
+    locks = np.interp(cols, np.linspace(0, size, 17), rng.uniform(0.5, 1.0, 17))
+    length = np.clip(locks + rng.normal(0, 0.1, size), 0.2, 1.0)
+    t = (np.arange(half) + 0.5) / half  # 0 at the roots, 1 at the tips
+    fade = np.clip((length[None, :] - t[:, None]) / 0.08, 0, 1)
+    strands = 0.55 + 0.45 * np.sin(2 * np.pi * cols * 97 / size + rng.uniform(0, 6, size)) ** 2
+    card = fade * strands[None, :] * (rng.uniform(size=size) < 0.9)[None, :]
+    dense = np.ones((size - half, size), np.float32)
+    return np.round(np.concatenate([dense, card]) * 255).astype(np.uint8)
 
 
 def hair_material(spec, size: int = 1024) -> Material:
-    """The Material of a hair or face built-in (hair fabric, its colour, alpha cut-out)."""
+    """The Material of a hair or face built-in (hair fabric, its colour, alpha cut-out).
+
+    Lashes and brows are thinner than a pixel at most distances: they blend (glTF ``BLEND``)
+    rather than cut out, so they read as soft fringes instead of dotted cards.
+    """
     if spec.name == "eyebrows":
-        alpha = brow_alpha(size)
+        alpha, mode = brow_alpha(size), "BLEND"
     elif spec.name == "eyelashes":
-        alpha = lash_alpha(size)
+        alpha, mode = lash_alpha(size), "BLEND"
     else:
-        alpha = strand_alpha(size)
+        alpha, mode = strand_alpha(size), "MASK"
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
+    if mode != m.alpha_mode:
+        from dataclasses import replace
+
+        m = replace(m, alpha_mode=mode)
     return m
