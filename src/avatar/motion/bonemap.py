@@ -9,6 +9,10 @@ Conventions are JSON files (``avatar/data/bonemaps/*.json``: ``{"name", "descrip
 "bones": {canonical: [candidate names, first present wins]}}``); a user file of the same
 shape can be passed anywhere a convention name is accepted. Names match case-insensitively
 after dropping any ``prefix:`` (``mixamorig:Hips``, ``mixamorig1:Hips``).
+
+When names match no convention well (any body bone missing), the roles are inferred from
+the hierarchy and geometry (``avatar.motion.topology``): fully when names found under half
+of the body bones, otherwise only the missing ones; ``BoneMap.inferred`` says which.
 """
 
 from __future__ import annotations
@@ -19,7 +23,10 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from avatar.errors import FormatError, ParameterError, unknown_name
+from avatar.motion import topology
 from avatar.rig.skeleton import Skeleton
 
 _TRUNK = {"hips": "spine", "spine": "chest", "chest": "neck", "neck": "head", "head": None}
@@ -61,11 +68,13 @@ class BoneMap:
     convention: the convention's name (or the user file's path).
     bones: canonical name -> bone index in the skeleton.
     missing: canonical body bones (``CORE``) the skeleton lacks under this convention.
+    inferred: canonical bones found from the hierarchy and geometry, not by name.
     """
 
     convention: str
     bones: dict[str, int]
     missing: tuple[str, ...]
+    inferred: tuple[str, ...] = ()
 
     def name_of(self, skeleton: Skeleton, canonical: str) -> str:
         return skeleton.names[self.bones[canonical]]
@@ -123,26 +132,56 @@ def apply(skeleton: Skeleton, table: dict[str, list[str]], name: str = "custom")
     return BoneMap(name, bones, missing)
 
 
-def detect(skeleton: Skeleton, convention: str | os.PathLike[str] = "auto") -> BoneMap:
-    """The bone map of a skeleton: by convention name, user file, or "auto" (best match).
+def detect(
+    skeleton: Skeleton,
+    convention: str | os.PathLike[str] = "auto",
+    heads: np.ndarray | None = None,
+) -> BoneMap:
+    """The bone map of a skeleton: by convention name, user file, "topology" or "auto".
 
-    "auto" scores every shipped convention by the body bones it finds and keeps the best
-    (unknown conventions need a bone map file). Raises ParameterError for an unknown
-    convention name or a skeleton without recognisable hips.
+    "auto" scores every shipped convention by the body bones it finds and keeps the best;
+    when that lacks body bones, the hierarchy and geometry fill them in (see
+    ``topology.infer``; ``heads`` (T, J, 3), e.g. a clip's posed heads, help when the rest
+    pose is not upright). Raises ParameterError for an unknown convention name or a
+    skeleton without recognisable hips.
     """
     known = conventions()
+    if convention == "topology":
+        return _by_topology(skeleton, heads)
     if convention != "auto":
         key = str(convention)
         if key in known:
             return apply(skeleton, known[key], key)
         if Path(key).suffix == ".json" or os.sep in key:
             return apply(skeleton, load(key), key)
-        raise unknown_name("bone map convention", key, known)
+        raise unknown_name("bone map convention", key, [*known, "topology"])
     maps = [apply(skeleton, table, name) for name, table in known.items()]
     best = max(maps, key=lambda m: (len(CORE) - len(m.missing), len(m.bones)))
+    if best.missing:
+        best = _fill(best, skeleton, heads)
     if "hips" not in best.bones:
         raise ParameterError(
             f"cannot find the hips of this skeleton (best convention {best.convention!r} "
             f"lacks {', '.join(best.missing)}); pass a bone map file"
         )
     return best
+
+
+def _by_topology(skeleton: Skeleton, heads: np.ndarray | None) -> BoneMap:
+    bones = topology.infer(skeleton, heads)
+    return BoneMap("topology", bones, tuple(b for b in CORE if b not in bones), tuple(bones))
+
+
+def _fill(named: BoneMap, skeleton: Skeleton, heads: np.ndarray | None) -> BoneMap:
+    """Names found under half the body bones: trust the topology for all; otherwise add
+    what topology finds for the missing roles on bones no name claimed."""
+    inferred = _by_topology(skeleton, heads)
+    if len(CORE) - len(named.missing) < len(CORE) / 2:
+        return inferred if len(inferred.bones) >= len(named.bones) else named
+    used = set(named.bones.values())
+    extra = {r: j for r, j in inferred.bones.items() if r not in named.bones and j not in used}
+    if not extra:
+        return named
+    bones = {**named.bones, **extra}
+    missing = tuple(b for b in CORE if b not in bones)
+    return BoneMap(f"{named.convention}+topology", bones, missing, tuple(extra))

@@ -88,7 +88,7 @@ def retarget(
     """
     anim = timing.resample(timing.select(source_animation, frames), fps)
     src = _forward(source_skeleton, anim)
-    smap = bonemap.detect(source_skeleton, source_map)
+    smap = bonemap.detect(source_skeleton, source_map, src.pos)
     tmap = bonemap.detect(target_skeleton, target_map)
     pairs = make_pairs(source_skeleton, smap, target_skeleton, tmap, match_names)
     align = calibrate.offsets(pairs, source_skeleton, src.rot, src.pos, target_skeleton)
@@ -314,16 +314,22 @@ def _report(pairs, smap, tmap, source, target, scale, out: Animation, quality) -
     used_s = {p.source for p in pairs}
     used_t = {p.target for p in pairs}
     notes = []
-    if smap.missing:
-        notes.append(f"source lacks {', '.join(smap.missing)}")
-    if tmap.missing:
-        notes.append(f"target lacks {', '.join(tmap.missing)}")
+    for side, bmap, skeleton in (("source", smap, source), ("target", tmap, target)):
+        if bmap.inferred:
+            found = ", ".join(f"{r}={skeleton.names[bmap.bones[r]]}" for r in bmap.inferred)
+            notes.append(f"{side} mapped by topology (names unknown): {found}")
+        if bmap.missing:
+            notes.append(f"{side} lacks {', '.join(bmap.missing)}")
+    unused = [n for j, n in enumerate(source.names) if j not in used_s]
+    if unused:
+        shown = ", ".join(unused[:8]) + (", ..." if len(unused) > 8 else "")
+        notes.append(f"{len(unused)} source bones not mapped: {shown}")
     return RetargetReport(
         source_convention=smap.convention,
         target_convention=tmap.convention,
         mapped=tuple((p.role, source.names[p.source], target.names[p.target]) for p in pairs),
         unmapped_target=tuple(n for j, n in enumerate(target.names) if j not in used_t),
-        unused_source=tuple(n for j, n in enumerate(source.names) if j not in used_s),
+        unused_source=tuple(unused),
         scale=float(scale),
         frames=out.frames,
         fps=out.fps,
