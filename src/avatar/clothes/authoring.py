@@ -65,22 +65,71 @@ class Piece:
     binding: Binding
 
 
-def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease) -> Mesh:
+def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease, relax: int = 0) -> Mesh:
     """A surface of the chosen faces, pushed ``ease`` metres out along the skin normal.
 
     faces: (F, 4) base-mesh faces of the source surface; keep: (F,) bool.
     ease: float or callable (points (N, 3), arm (N,), leg (N,)) -> (N,) metres.
+    relax: smoothing passes over the cut's edges (``relax_boundary``); 0 keeps the mesh's
+    staircase of whole faces.
     Returns a Mesh (own vertex numbering) with box-projected UVs; faces face outward.
     """
     chosen = faces[keep]
     used, inverse = np.unique(chosen, return_inverse=True)
     points = body.vertices[used]
+    local = inverse.reshape(chosen.shape).astype(np.int32)
+    if relax:
+        points = relax_boundary(points, local, body.outward(points), relax)
     if callable(ease):
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
     points = points + np.asarray(ease)[..., None] * body.outward(points)
-    local = inverse.reshape(chosen.shape).astype(np.int32)
     return with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+
+
+def relax_boundary(
+    points: np.ndarray, faces: np.ndarray, normals: np.ndarray, passes: int
+) -> np.ndarray:
+    """(N, 3) points with the open edges of a cut smoothed into curves.
+
+    A cut along mesh faces ends in a staircase. Each pass smooths every boundary loop along
+    itself (Taubin's shrink-free lambda/mu pair), then lets the next ring of vertices settle
+    between their neighbours so the border faces keep their shape; every move stays in the
+    surface's tangent plane at the vertex's original position (normals (N, 3)).
+    Vertices where two loops touch stay put.
+    """
+    from avatar.clothes.shell import boundary_edges
+
+    edges, _ = boundary_edges(faces)
+    count = len(points)
+    seen = np.bincount(edges[:, 0], minlength=count)
+    nxt = np.full(count, -1)
+    prv = np.full(count, -1)
+    nxt[edges[:, 0]], prv[edges[:, 1]] = edges[:, 1], edges[:, 0]
+    loop = np.flatnonzero((seen == 1) & (nxt >= 0) & (prv >= 0))
+    a = faces.reshape(-1)
+    b = np.roll(faces, -1, axis=1).reshape(-1)
+    ring = np.setdiff1d(np.unique(np.concatenate([b[np.isin(a, loop)], a[np.isin(b, loop)]])),
+                        np.flatnonzero(seen > 0))  # fmt: skip
+    origin, n = points.astype(np.float64), normals / np.linalg.norm(normals, axis=1)[:, None]
+    p = origin.copy()
+
+    def settle(moved: np.ndarray, which: np.ndarray) -> None:
+        step = moved - origin[which]
+        p[which] = moved - np.einsum("nd,nd->n", step, n[which])[:, None] * n[which]
+
+    for _ in range(passes):
+        for weight in (0.5, -0.53):
+            target = (p[nxt[loop]] + p[prv[loop]]) / 2
+            settle(p[loop] + weight * (target - p[loop]), loop)
+        total = np.zeros_like(p)
+        degree = np.zeros(count)
+        np.add.at(total, a, p[b])
+        np.add.at(total, b, p[a])
+        np.add.at(degree, a, 1)
+        np.add.at(degree, b, 1)
+        settle(0.5 * p[ring] + 0.5 * total[ring] / degree[ring, None], ring)
+    return p
 
 
 def orient_outward(body: AuthoringBody, points: np.ndarray, faces: np.ndarray) -> Mesh:

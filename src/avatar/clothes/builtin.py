@@ -26,6 +26,9 @@ from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
 
 
+RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
+
+
 @dataclass(frozen=True)
 class Spec:
     """A built-in garment's recipe."""
@@ -44,13 +47,13 @@ class Spec:
 def _tights(body: AuthoringBody, keep_fn, ease) -> Piece:
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
-    return bound(body, cut(body, faces, keep_fn(ff, body.marks), ease), faces)
+    return bound(body, cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX), faces)
 
 
 def _skirt(body: AuthoringBody, bottom_z: float, ease) -> Piece:
     faces = body.group_faces("helper-skirt")
     centre_z = body.vertices[faces].mean(axis=1)[:, 2]
-    return bound(body, cut(body, faces, centre_z > bottom_z, ease), faces)
+    return bound(body, cut(body, faces, centre_z > bottom_z, ease, relax=RELAX), faces)
 
 
 def _z(ff):
@@ -78,9 +81,16 @@ def bottom(length: float, rise: float = 0.07):
 
 
 def tank(ff, m):
-    armhole = (np.abs(ff.centre[:, 0]) > 0.7 * abs(m.shoulder[0, 0])) & (_z(ff) > m.chest_z - 0.06)
-    body = (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.04) & (_z(ff) < m.neck[2] - 0.07)
-    return body & ~armhole
+    """Torso on straps: a neckline scooped deeper in front than behind, oval armholes
+    reaching a hand's width below the shoulder joint (shoulder faces count as arm)."""
+    x, y, z = ff.centre.T
+    across, shoulder_x = np.abs(x), abs(m.shoulder[0, 0])
+    armhole = ((across - shoulder_x) / 0.062) ** 2 + ((z - m.shoulder[0, 2] - 0.05) / 0.15) ** 2
+    depth = np.where(y < m.neck[1], 0.12, 0.05)
+    neckline = m.neck[2] - depth * np.sqrt(np.clip(1 - (across / 0.07) ** 2, 0, 1))
+    upper = (ff.part == "torso") | ((ff.part == "arm") & (across < shoulder_x - 0.03))
+    body = upper & (z > m.hip[0, 2] + 0.04) & (armhole > 1) & (across < shoulder_x)
+    return body & ~((across < 0.07) & (z > neckline))
 
 
 def swimsuit(ff, m):
