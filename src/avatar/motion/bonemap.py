@@ -118,15 +118,15 @@ def load(path: str | os.PathLike[str]) -> dict[str, list[str]]:
 
 def apply(skeleton: Skeleton, table: dict[str, list[str]], name: str = "custom") -> BoneMap:
     """Resolve a {canonical: candidates} table against a skeleton's bone names."""
-    index = {}
+    index: dict[str, int] = {}
     for j, n in enumerate(skeleton.names):
         index.setdefault(normalise(n), j)
-    bones = {}
+    bones: dict[str, int] = {}
     for canonical, candidates in table.items():
         for cand in candidates:
-            j = index.get(normalise(cand))
-            if j is not None:
-                bones[canonical] = j
+            found = index.get(normalise(cand))
+            if found is not None:
+                bones[canonical] = found
                 break
     missing = tuple(b for b in CORE if b not in bones)
     return BoneMap(name, bones, missing)

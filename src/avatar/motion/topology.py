@@ -106,12 +106,14 @@ def infer(skeleton: Skeleton, heads: np.ndarray | None = None) -> dict[str, int]
 def _upright(roles: dict[str, int], heads: np.ndarray) -> bool:
     """Head above chest above hips above knees above feet, left and right."""
     z = heads[:, 2]
-    chain = [roles.get(r) for r in ("head", "chest", "hips")]
-    ok = None not in chain and bool(np.all(np.diff(z[chain]) < 0))
-    for side in "LR":
-        leg = [roles.get(f"{r}.{side}") for r in ("thigh", "shin", "foot")]
-        ok = ok and None not in leg and bool(np.all(np.diff(z[leg]) < 0))
-    return bool(ok)
+    chains = [("head", "chest", "hips")]
+    chains += [(f"thigh.{s}", f"shin.{s}", f"foot.{s}") for s in "LR"]
+    for chain in chains:
+        if not all(r in roles for r in chain):
+            return False
+        if not np.all(np.diff(z[[roles[r] for r in chain]]) < 0):
+            return False
+    return True
 
 
 def _roles(tree: _Tree, pose: np.ndarray) -> dict[str, int]:
@@ -222,7 +224,7 @@ def _cut(arcs: np.ndarray, first: int, cuts: int, shares: tuple[float, ...]) -> 
     """Indices (ascending, > ``first``, below the tip) of ``cuts`` places whose segment
     lengths best match ``shares`` of the whole; () when there are too few places."""
     places = range(first + 1, len(arcs) - 1)
-    best, out = np.inf, ()
+    best, out = np.inf, ()  # type: tuple[float, tuple[int, ...]]
     total = arcs[-1] - arcs[first]
     for pick in combinations(places, cuts):
         edges = arcs[[first, *pick, len(arcs) - 1]]
