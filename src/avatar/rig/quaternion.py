@@ -6,18 +6,55 @@ import numpy as np
 
 
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a * b, shapes (..., 4)."""
-    aw, ax, ay, az = np.moveaxis(a, -1, 0)
-    bw, bx, by, bz = np.moveaxis(b, -1, 0)
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
+    """Hamilton product a * b, shapes (..., 4) (broadcast)."""
+    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    # Written component by component into one buffer: for the (T, J, 4) stacks of motion
+    # work this is several times faster than a stack of 4x4 or 3x3 matrix products.
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
+    out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
+    out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
+    out[..., 3] = aw * bz + ax * by - ay * bx + az * bw
+    return out
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors v (..., 3) turned by unit quaternions q (..., 4) (broadcast) -> (..., 3)."""
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    # v' = v + w t + u x t with t = 2 u x v (u = the vector part): 15 products, no matrix.
+    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    out = np.empty(np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,))
+    out[..., 0] = vx + w * tx + y * tz - z * ty
+    out[..., 1] = vy + w * ty + z * tx - x * tz
+    out[..., 2] = vz + w * tz + x * ty - y * tx
+    return out
+
+
+def between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(..., 4) shortest-arc rotations taking the directions of a to those of b (..., 3).
+
+    Opposite directions turn by half a turn about an axis perpendicular to a; a zero
+    vector gives the identity.
+    """
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+    na, nb = np.linalg.norm(a, axis=-1), np.linalg.norm(b, axis=-1)
+    ab = na * nb
+    q = np.empty(a.shape[:-1] + (4,))
+    q[..., 0] = ab + np.sum(a * b, -1)  # |a||b| (1 + cos): the half-angle form, no trig
+    q[..., 1:] = np.cross(a, b)
+    n = np.linalg.norm(q, axis=-1)
+    q /= np.where(n > 0, n, 1.0)[..., None]
+    opposite = n <= 1e-9 * ab
+    if np.any(opposite) or np.any(ab == 0):
+        other = np.where((np.abs(a[..., 0]) < 0.9 * na)[..., None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        axis = np.cross(a, other)
+        axis /= np.maximum(np.linalg.norm(axis, axis=-1, keepdims=True), 1e-300)
+        flip = np.concatenate([np.zeros(a.shape[:-1] + (1,)), axis], -1)
+        q = np.where((opposite & (ab > 0))[..., None], flip, q)
+        q = np.where((ab == 0)[..., None], [1.0, 0.0, 0.0, 0.0], q)
+    return q
 
 
 def conjugate(q: np.ndarray) -> np.ndarray:
