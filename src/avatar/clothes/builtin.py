@@ -25,7 +25,6 @@ from avatar.clothes.authoring import (
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
 
-
 RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
 
 
@@ -150,7 +149,7 @@ SPECS = [
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
-    Spec("hair-short", "hair", lambda b: hair.scalp(b, 0.006), "hair", "dark brown hair", 0.008, 70, ("hair", "short")),  # noqa: E501
+    Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
     Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501

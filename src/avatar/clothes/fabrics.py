@@ -107,7 +107,8 @@ def normal_map(height: np.ndarray, depth: float) -> np.ndarray:
     return np.round((n * 0.5 + 0.5) * 255).astype(np.uint8)
 
 
-def _srgb(linear: np.ndarray) -> np.ndarray:
+def srgb(linear: np.ndarray) -> np.ndarray:
+    """uint8 sRGB of linear values (clipped to [0, 1])."""
     linear = np.clip(linear, 0, 1)
     s = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
     return np.round(s * 255).astype(np.uint8)
@@ -127,7 +128,7 @@ def colour_map(fabric_name: str, colour, size: int = 1024, seed: int = 0) -> np.
     rgb = np.asarray(COLOURS.get(colour, colour) if isinstance(colour, str) else colour)
     h, _, _ = maps(fabric_name, size, seed)
     shade = 1.0 + FABRICS[fabric_name].contrast * h
-    return _srgb(rgb[None, None, :] * shade[..., None])
+    return srgb(rgb[None, None, :] * shade[..., None])
 
 
 def material(

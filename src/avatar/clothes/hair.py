@@ -51,11 +51,13 @@ def scalp_mask(body: AuthoringBody, front: float, side: float, back: float) -> n
 
 
 def cap_uvs(mesh: Mesh, centre: np.ndarray) -> Mesh:
-    """UVs of a scalp cap in the dense half of the hair texture (u around, v up)."""
+    """UVs of a scalp cap in the dense half of the hair texture (u around, v up), kept off
+    the half's edges; faces across the seam behind the head are unwrapped (u tiles)."""
     rel = mesh.vertices[mesh.faces] - centre  # (F, C, 3)
     angle = np.arctan2(rel[..., 0], -rel[..., 1])
-    u = (angle / np.pi + 1) * 2.0
-    v = 0.5 + 0.5 * np.clip((rel[..., 2] + 0.1) / 0.25, 0, 1)
+    u = (angle / np.pi + 1) * 2.0  # [0, 4]: the texture repeats four times around
+    u = np.where(u.max(axis=1, keepdims=True) - u > 2.0, u + 4.0, u)
+    v = 0.55 + 0.4 * np.clip((rel[..., 2] + 0.1) / 0.25, 0, 1)
     uv = np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)
     return per_corner(mesh, uv)
 
@@ -72,6 +74,156 @@ def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) 
     mesh = cut(body, faces, scalp_mask(body, front, side, back), ease)
     centre, _ = eye_level(body)
     return bound(body, cap_uvs(mesh, centre), faces)
+
+
+# A short haircut's hairline, by the direction around the head (degrees from the front):
+# height above eye level. Rounded temple corners, sideburns in front of the ears, a line
+# curving over each ear and down to the nape.
+HAIRLINE_DEG = (0, 30, 45, 60, 72, 76, 84, 88, 112, 120, 140, 180)
+HAIRLINE_M = (0.07, 0.068, 0.072, 0.05, 0.03, -0.012, -0.012, 0.035, 0.035, -0.02, -0.055, -0.065)
+
+
+def head_frame(body: AuthoringBody) -> tuple[np.ndarray, float]:
+    """(centre of the skull (3,), eye height z): the middle of the head's front-to-back and
+    side-to-side extent at eye height (the face's dense vertices do not pull it forward)."""
+    _, eye_z = eye_level(body)
+    head = body.vertices[:SKIN][body.part[:SKIN] == "head"]
+    y = (head[:, 1].min() + head[:, 1].max()) / 2
+    return np.array([0.0, y, eye_z]), eye_z
+
+
+def around(points: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """(N,) degrees around the vertical axis through ``centre``: 0 front, 180 back."""
+    rel = points - centre
+    return np.degrees(np.abs(np.arctan2(rel[:, 0], -rel[:, 1])))
+
+
+def hairline_mask(body: AuthoringBody, lift: float = 0.0) -> np.ndarray:
+    """(F,) bool skin faces inside the hairline (``HAIRLINE_*`` raised by ``lift`` m)."""
+    centre, eye_z = head_frame(body)
+    c = body.vertices[body.skin_faces].mean(axis=1)
+    line = eye_z + lift + np.interp(around(c, centre), HAIRLINE_DEG, HAIRLINE_M)
+    ear = (np.abs(c[:, 0]) > 0.066) & (c[:, 2] < eye_z + 0.033)
+    near = np.hypot(c[:, 0], c[:, 1] - centre[1]) < 0.11
+    return near & (c[:, 2] > line) & ~ear
+
+
+def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:
+    """The scalp inside the hairline as a dense hair surface (what shows between cards)."""
+    faces = body.skin_faces
+    mesh = cut(body, faces, hairline_mask(body), ease, relax=8)
+    centre, _ = head_frame(body)
+    return bound(body, cap_uvs(mesh, centre), faces)
+
+
+def flow_crown(crown_offset=(0.0, 0.035, 0.1), sweep: float = 0.6):
+    """A hair flow field radiating from the crown, the front swept towards +x."""
+
+    def flow(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+        crown = centre + np.asarray(crown_offset)
+        d = points - crown
+        front = np.clip((centre[1] - points[:, 1]) / 0.08, 0, 1) * np.clip(
+            (points[:, 2] - eye_z - 0.04) / 0.04, 0, 1
+        )
+        d[:, 0] += sweep * front * np.linalg.norm(d, axis=1)
+        return d
+
+    return flow
+
+
+def flow_tied(tie_offset=(0.0, 0.07, 0.0)):
+    """A hair flow field drawn back to a tie point behind the head."""
+
+    def flow(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+        return centre + np.asarray(tie_offset) - points
+
+    return flow
+
+
+def grow_cards(
+    body: AuthoringBody,
+    flow,
+    count: int = 700,
+    length=(0.035, 0.055),
+    width: float = 0.015,
+    lift=(0.006, 0.022),
+    segments: int = 4,
+    seed: int = 0,
+) -> Piece:
+    """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
+
+    Each card starts a few millimetres above the scalp and rises to its lift as it runs
+    ``length`` metres along the flow, so higher cards cover lower ones the way layered hair
+    does; ``lift`` (low, high) grows from the hairline (low) to the top of the head (high).
+    UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
+    """
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
+    roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
+    depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
+    top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
+    top *= rng.uniform(0.55, 1.0, count)
+    # Short at the hairline (a fringe would hang over the face), full length further in.
+    size = rng.uniform(*length, count) * (0.45 + 0.55 * np.clip(depth / 0.04, 0, 1))
+    rows = [roots]
+    point = roots
+    for k in range(1, segments + 1):
+        step = _tangent(body, point, flow(point, centre, eye_z))
+        point = _above_skin(body, point + step * (size / segments)[:, None],
+                            0.002 + (top - 0.002) * (k / segments) ** 0.7)  # fmt: skip
+        rows.append(point)
+    path = np.stack(rows, 1)  # (N, K+1, 3)
+    side = np.cross(
+        body.outward(path.reshape(-1, 3)).reshape(path.shape), np.gradient(path, axis=1)
+    )
+    side /= np.linalg.norm(side, axis=-1, keepdims=True)
+    half = (
+        (width / 2)
+        * rng.uniform(0.7, 1.2, count)[:, None, None]
+        * np.linspace(1, 0.7, segments + 1)[None, :, None]
+    )
+    verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2(K+1), 3)
+    n = segments + 1
+    k = np.arange(segments)
+    quad = np.stack([k, k + 1, n + k + 1, n + k], 1)
+    faces = (quad[None] + (2 * n * np.arange(count))[:, None, None]).reshape(-1, 4)
+    u0 = rng.uniform(0, 1, count)[:, None]
+    t = np.linspace(0, 1, n)[None, :]
+    uv = np.concatenate(
+        [np.stack(np.broadcast_arrays(u0, 0.5 * (1 - t)), -1),
+         np.stack(np.broadcast_arrays(u0 + 0.12, 0.5 * (1 - t)), -1)], 1
+    )  # fmt: skip
+    mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
+    mesh = Mesh(mesh.vertices, mesh.faces, uv.reshape(-1, 2).astype(np.float32), mesh.faces.copy())
+    return bound(body, mesh, body.skin_faces)
+
+
+def _scatter(body: AuthoringBody, keep: np.ndarray, count: int, rng) -> np.ndarray:
+    """(count, 3) random points on the chosen skin faces, uniform by area."""
+    quads = body.vertices[body.skin_faces[keep]]
+    tris = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)
+    pick = rng.choice(len(tris), count, p=area / area.sum())
+    a, b = rng.uniform(size=(2, count))
+    flip = a + b > 1
+    a[flip], b[flip] = 1 - a[flip], 1 - b[flip]
+    t = tris[pick]
+    return t[:, 0] + a[:, None] * (t[:, 1] - t[:, 0]) + b[:, None] * (t[:, 2] - t[:, 0])
+
+
+def _tangent(body: AuthoringBody, points: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """(N, 3) unit directions projected into the skin's tangent plane near each point."""
+    n = body.outward(points)
+    d = direction - np.einsum("nd,nd->n", direction, n)[:, None] * n
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
+
+
+def _above_skin(body: AuthoringBody, points: np.ndarray, height: np.ndarray) -> np.ndarray:
+    """(N, 3) points moved to ``height`` m above the skin along its normal."""
+    _, i = body.skin_tree.query(points)
+    skin, n = body.vertices[i], body.skin_normals[i].astype(np.float64)
+    on = points - np.einsum("nd,nd->n", points - skin, n)[:, None] * n
+    return on + np.asarray(height)[:, None] * n
 
 
 def helper_cards(body: AuthoringBody, layers=(0.006, 0.014, 0.022)) -> Piece:

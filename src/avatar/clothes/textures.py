@@ -14,6 +14,8 @@ Layouts (UV v up, image row 0 at the top, ``material`` module convention):
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from avatar.clothes import fabrics
@@ -152,21 +154,34 @@ def strand_alpha(size: int, seed: int = 0) -> np.ndarray:
     return np.round(np.concatenate([dense, card]) * 255).astype(np.uint8)
 
 
+def strand_shade(size: int, seed: int = 0) -> np.ndarray:
+    """(S, S) float32 brightness of the hair layout: strand-to-strand variation along u,
+    dark roots lightening to the tips on the cards, the scalp half as dark as the roots."""
+    rng = np.random.default_rng([seed, size, 3])
+    cols = np.arange(size)
+    locks = np.interp(cols, np.linspace(0, size, 33), rng.uniform(0.8, 1.2, 33), period=size)
+    strand = locks * rng.uniform(0.82, 1.18, size)
+    half = size // 2
+    t = (np.arange(size - half) + 0.5) / (size - half)  # 0 at the roots, 1 at the tips
+    along = np.concatenate([np.full(half, 0.6), 0.6 + 0.65 * t**0.8])
+    return (along[:, None] * strand[None, :]).astype(np.float32)
+
+
 def hair_material(spec, size: int = 1024) -> Material:
-    """The Material of a hair or face built-in (hair fabric, its colour, alpha cut-out).
+    """The Material of a hair or face built-in: strand colour, normal and roughness maps
+    of the ``hair`` fabric in the spec's colour, and the strand alpha of its kind.
 
     Lashes and brows are thinner than a pixel at most distances: they blend (glTF ``BLEND``)
-    rather than cut out, so they read as soft fringes instead of dotted cards.
+    rather than cut out, so they read as soft fringes instead of dotted cards. Hair cards
+    cut out (``MASK``), which real-time engines draw without sorting.
     """
     if spec.name == "eyebrows":
-        alpha, mode = brow_alpha(size), "BLEND"
+        alpha, mode, shade = brow_alpha(size), "BLEND", np.ones((size, size), np.float32)
     elif spec.name == "eyelashes":
-        alpha, mode = lash_alpha(size), "BLEND"
+        alpha, mode, shade = lash_alpha(size), "BLEND", np.ones((size, size), np.float32)
     else:
-        alpha, mode = strand_alpha(size), "MASK"
+        alpha, mode, shade = strand_alpha(size), "MASK", strand_shade(size)
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
-    if mode != m.alpha_mode:
-        from dataclasses import replace
-
-        m = replace(m, alpha_mode=mode)
-    return m
+    rgb = np.asarray(fabrics.COLOURS[spec.colour])[None, None, :] * shade[..., None]
+    colour = np.concatenate([fabrics.srgb(rgb), alpha[..., None]], -1)
+    return replace(m, base_color_texture=colour, alpha_mode=mode)
