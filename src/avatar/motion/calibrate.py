@@ -14,7 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from avatar.motion import geometry
-from avatar.motion.pairs import Pair, segment_rest, segment_world
+from avatar.motion.pairs import Pair, segment_rest, segment_world, segments
+from avatar.rig import quaternion
+from avatar.rig.kinematics import rest_quaternions
 from avatar.rig.skeleton import Skeleton
 
 _BACK = np.array([0.0, 1.0, 0.0])  # Avatar characters face -Y: knees bend toward +Y
@@ -23,7 +25,8 @@ _MIN_BEND = np.sin(np.radians(15.0))
 
 
 class _Side:
-    """Source (T-frame) or target (rest) view of a skeleton: world rotations and heads."""
+    """Source (T-frame) or target (rest) view of a skeleton: world rotations (quaternions)
+    and heads."""
 
     def __init__(self, skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray):
         self.skeleton, self.rot, self.pos = skeleton, rot, pos
@@ -34,26 +37,33 @@ class _Side:
 
 
 def offsets(pairs: list[Pair], source: Skeleton, src_rot: np.ndarray, src_pos: np.ndarray,
-            target: Skeleton) -> np.ndarray:  # fmt: skip
-    """(P, 3, 3) alignment A per pair; target world = source world @ A."""
+            target: Skeleton, src_seg: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """(P, 4) alignment quaternion A per pair: target world = source world * A.
+
+    src_rot: (T, Js, 4) source world rotations; src_pos: (T, Js, 3) heads; src_seg:
+    (T, P, 3) the pairs' source segments (``pairs.segments``), computed when None.
+    """
     src = _Side(source, src_rot, src_pos)
-    t_rot = target.rest[None, :, :3, :3]
-    tgt = _Side(target, t_rot, target.heads[None])
-    by_role = {p.role: p for p in pairs}
-    refs = _references(by_role, src, tgt)
+    tgt = _Side(target, rest_quaternions(target)[0][None], target.heads[None])
+    refs = _references({p.role: p for p in pairs}, src, tgt)
+    if src_seg is None:
+        src_seg = segments(source, src_rot, src_pos, [p.source for p in pairs],
+                           [p.source_end for p in pairs])  # fmt: skip
     out = np.full((len(pairs), 3, 3), np.nan)
-    for k, pair in enumerate(pairs):
-        ref = refs.get(_reference_name(pair))
-        if ref is None:
-            continue
-        e_s = _local_median(src_rot[:, pair.source], src.seg(pair, True))
-        s_s = _local_median(src_rot[:, pair.source], ref[0])
-        rt = target.rest[pair.target, :3, :3]
-        e_t = segment_rest(target, pair.target, pair.target_end)
-        s_t = rt.T @ ref[1]
-        out[k] = geometry.frame(e_s, s_s) @ geometry.frame(e_t, s_t).T
+    rows = [(k, ref) for k, p in enumerate(pairs)
+            if (ref := refs.get(_reference_name(p))) is not None]  # fmt: skip
+    if rows:
+        ks = [k for k, _ in rows]
+        bones = [pairs[k].source for k in ks]
+        world = np.concatenate([src_seg[:, ks], np.stack([r[0] for _, r in rows], 1)], 1)
+        local = _local_median(src_rot[:, bones + bones], world)  # one median for all pairs
+        rt = target.rest[[pairs[k].target for k in ks], :3, :3]
+        e_t = np.stack([segment_rest(target, pairs[k].target, pairs[k].target_end) for k in ks])
+        s_t = np.einsum("kba,kb->ka", rt, np.stack([r[1] for _, r in rows]))
+        frame_t = geometry.frame(e_t, s_t)
+        out[ks] = geometry.frame(local[: len(ks)], local[len(ks) :]) @ np.swapaxes(frame_t, -1, -2)
     _choose(out, pairs, source, target)
-    return out
+    return quaternion.from_matrix(out)
 
 
 def _reference_name(pair: Pair) -> str | None:
@@ -111,16 +121,16 @@ def _hinge(by_role, src: _Side, tgt: _Side, upper: str, lower: str, bend: np.nda
     if bent.sum() < 1:
         return fallback
     rot = src.rot[:, up.source]
-    local = geometry.unit(np.median(geometry.unit(np.einsum("tba,tb->ta", rot[bent],
-                                                            cross[bent])), axis=0))  # fmt: skip
-    world_s = rot @ local
+    local = _local_median(rot[bent], cross[bent])
+    world_s = quaternion.rotate(rot, local)
     world_t = geometry.unit(np.cross(tgt.seg(up, False)[0], bend))
     return world_s, world_t
 
 
 def _local_median(rot: np.ndarray, world: np.ndarray) -> np.ndarray:
-    """(3,) median over frames of world vectors (T, 3) seen in a bone's frames (T, 3, 3)."""
-    local = geometry.unit(np.einsum("tba,tb->ta", rot, world))
+    """(..., 3) median over frames of world vectors (T, ..., 3) seen in bone frames
+    (T, ..., 4)."""
+    local = geometry.unit(quaternion.rotate(quaternion.conjugate(rot), world))
     return geometry.unit(np.median(local, axis=0))
 
 

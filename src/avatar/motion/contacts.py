@@ -16,6 +16,7 @@ import numpy as np
 
 from avatar.motion import geometry
 from avatar.motion.bonemap import BoneMap
+from avatar.rig import quaternion
 from avatar.rig.skeleton import Skeleton
 
 FOOT_ROLES = ("foot.L", "toe.L", "foot.R", "toe.R")
@@ -83,21 +84,24 @@ def _drop_short(mask: np.ndarray, length: int) -> np.ndarray:
 
 def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray,
           root: np.ndarray, fps: float) -> np.ndarray:  # fmt: skip
-    """Bend the target's legs so pinned joints stay put. Returns new world rotations."""
+    """Bend the target's legs so pinned joints stay put.
+
+    world: (T, J, 4) target world rotations (NaN: not evaluated); root: (T, 3) hips heads.
+    Returns new world rotations.
+    """
     world = world.copy()
     hips = tmap.bones["hips"]
     legs = [tmap.bones[f"{r}.{s}"] for r in ("thigh", "shin", "foot", "toe") for s in "LR"
             if f"{r}.{s}" in tmap.bones]  # fmt: skip
-    from avatar.motion.retarget import _ancestors
-
-    pos = geometry.positions(target, world, {hips: root}, _ancestors(target, legs))
+    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, legs))
     for side in ("L", "R"):
-        roles = [tmap.bones.get(f"{r}.{side}") for r in ("thigh", "shin", "foot")]
-        if None in roles:
+        roles = [f"{r}.{side}" for r in ("thigh", "shin", "foot")]
+        if any(r not in tmap.bones for r in roles):
             continue
         goal = _ankle_goals(feet.pinned[side], pos, tmap, side, target, fps)
         if goal is not None:
-            _two_bone_ik(world, pos, target, *roles, goal)  # type: ignore[misc]
+            thigh, shin, foot = (tmap.bones[r] for r in roles)
+            _two_bone_ik(world, pos, target, thigh, shin, foot, goal)
     return world
 
 
@@ -142,22 +146,21 @@ def _leg(target: Skeleton, tmap: BoneMap, side: str) -> float:
 
 def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int, goal) -> None:
     """Rotate thigh and shin chains (in place) so the ankle reaches ``goal`` (T, 3)."""
-    from avatar.motion.retarget import _path  # shared tree walk
-
     h, k, a = pos[:, thigh], pos[:, shin], pos[:, foot]
     l1 = np.linalg.norm(k - h, axis=-1)
     l2 = np.linalg.norm(a - k, axis=-1)
     hinge = np.cross(a - k, h - k)
     weak = np.linalg.norm(hinge, axis=-1) < 1e-6 * l1 * l2
-    hinge = np.where(weak[:, None], world[:, thigh, :, 0], hinge)  # straight leg: bone X
+    x_axis = quaternion.rotate(world[:, thigh], np.array([1.0, 0.0, 0.0]))
+    hinge = np.where(weak[:, None], x_axis, hinge)  # straight leg: bone X
     hinge = geometry.unit(hinge)
     reach = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
     cur = np.radians(geometry.angle(h - k, a - k))
     want = np.arccos(np.clip((l1**2 + l2**2 - reach**2) / (2 * l1 * l2), -1, 1))
-    bend = geometry.axis_angle(hinge, cur - want)
-    a_new = k + np.einsum("tab,tb->ta", bend, a - k)
-    turn = geometry.swing(a_new - h, goal - h)
-    upper = _path(target, thigh, shin)[:-1]
-    lower = _path(target, shin, foot)[:-1]
-    world[:, upper] = turn[:, None] @ world[:, upper]
-    world[:, lower] = (turn @ bend)[:, None] @ world[:, lower]
+    bend = quaternion.from_axis_angle(hinge, cur - want)
+    a_new = k + quaternion.rotate(bend, a - k)
+    turn = quaternion.between(a_new - h, goal - h)
+    upper = geometry.path(target, thigh, shin)[:-1]
+    lower = geometry.path(target, shin, foot)[:-1]
+    world[:, upper] = quaternion.multiply(turn[:, None], world[:, upper])
+    world[:, lower] = quaternion.multiply(quaternion.multiply(turn, bend)[:, None], world[:, lower])

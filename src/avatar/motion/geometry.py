@@ -1,9 +1,15 @@
-"""Small rotation helpers on arrays of 3-vectors and 3x3 matrices (batch dimensions lead)."""
+"""Small helpers on arrays of 3-vectors, 3x3 matrices and skeleton trees (batch dims lead).
+
+Per-frame work uses quaternions (``avatar.rig.quaternion``); the 3x3 helpers here serve
+frame-independent set-up (rest alignment).
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
+from avatar.rig import quaternion
+from avatar.rig.kinematics import levels
 from avatar.rig.skeleton import Skeleton
 
 
@@ -63,21 +69,43 @@ def offsets(skeleton: Skeleton) -> np.ndarray:
 
 def positions(skeleton: Skeleton, world: np.ndarray, roots: dict[int, np.ndarray],
               bones: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
-    """(T, J, 3) bone heads from world bone rotations (T, J, 3, 3).
+    """(T, J, 3) bone heads from world bone rotations (T, J, 4) quaternions.
 
     roots: bone index -> (T, 3) head positions of bones placed directly (translated bones);
     other parentless bones stay at their rest heads.
     bones: (J,) bool of the bones to evaluate (closed under parents); others are NaN.
     """
     off = offsets(skeleton)
-    out = np.full(world.shape[:-2] + (3,), np.nan)
-    for j, p in enumerate(skeleton.parents):
-        if bones is not None and not bones[j]:
-            continue
-        if j in roots:
-            out[:, j] = roots[j]
-        elif p < 0:
-            out[:, j] = skeleton.heads[j]
+    parents = skeleton.parents
+    out = np.full(world.shape[:-1] + (3,), np.nan)
+    for group in levels(parents, bones):
+        p = parents[group]
+        if p[0] < 0:
+            out[:, group] = skeleton.heads[group]
         else:
-            out[:, j] = out[:, p] + world[:, p] @ off[j]
+            out[:, group] = out[:, p] + quaternion.rotate(world[:, p], off[group])
+        for j in group:
+            if int(j) in roots:
+                out[:, j] = roots[int(j)]
     return out
+
+
+def ancestors(skeleton: Skeleton, bones) -> np.ndarray:
+    """(J,) bool: the given bones (negative ones ignored) and all their ancestors."""
+    out = np.zeros(len(skeleton.names), dtype=bool)
+    for j in bones:
+        while j >= 0 and not out[j]:
+            out[j] = True
+            j = int(skeleton.parents[j])
+    return out
+
+
+def path(skeleton: Skeleton, top: int, bottom: int) -> list[int]:
+    """Bones from ``top`` down to ``bottom`` (inclusive); [] when not an ancestor."""
+    out = [bottom]
+    while out[-1] != top:
+        parent = int(skeleton.parents[out[-1]])
+        if parent < 0:
+            return []
+        out.append(parent)
+    return out[::-1]

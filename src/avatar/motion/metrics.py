@@ -11,6 +11,7 @@ from avatar.motion import geometry
 from avatar.motion.bonemap import BoneMap
 from avatar.motion.contacts import FootContacts
 from avatar.motion.pairs import Pair, segment_world
+from avatar.rig import quaternion
 from avatar.rig.skeleton import Skeleton
 
 _HYPEREXTENSION_DEG = 10.0
@@ -111,7 +112,7 @@ def hyperextension(world: np.ndarray, pos: np.ndarray, tmap: BoneMap, target: Sk
                 np.cross(target.heads[idx[1]] - target.heads[idx[0]], bend)
             )
             a, b = pos[:, idx[1]] - pos[:, idx[0]], pos[:, idx[2]] - pos[:, idx[1]]
-            sign = np.sum(np.cross(a, b) * (world[:, idx[0]] @ hinge), axis=-1)
+            sign = np.sum(np.cross(a, b) * quaternion.rotate(world[:, idx[0]], hinge), axis=-1)
             bad |= (sign < 0) & (geometry.angle(a, b) > _HYPEREXTENSION_DEG)
     return int(bad.sum())
 

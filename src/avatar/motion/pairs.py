@@ -8,6 +8,7 @@ import numpy as np
 
 from avatar.motion import bonemap
 from avatar.motion.bonemap import BoneMap
+from avatar.rig import quaternion
 from avatar.rig.skeleton import Skeleton
 
 TRUNK = ("hips", "spine", "chest", "neck", "head")
@@ -79,14 +80,27 @@ def make_pairs(
     return pairs
 
 
+def segments(skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, bones, ends) -> np.ndarray:
+    """(T, n, 3) world segment vectors of ``bones`` (n,) ending at ``ends`` (n,) (encoded as
+    ``Pair.target_end``: a bone's head, -1 its own tail, -2 - b the tail of bone b).
+
+    rot: (T, J, 4) world bone rotations (quaternions); pos: (T, J, 3) world heads.
+    """
+    bones, ends = np.asarray(bones, dtype=int), np.asarray(ends, dtype=int)
+    other = np.where(ends == -1, bones, -2 - ends)
+    out = pos[:, np.where(ends >= 0, ends, other)] - pos[:, bones]
+    tail = np.flatnonzero(ends < 0)
+    if len(tail):
+        o = other[tail]
+        local = np.einsum("jba,jb->ja", skeleton.rest[o, :3, :3],
+                          skeleton.tails[o] - skeleton.heads[o])  # fmt: skip
+        out[:, tail] += quaternion.rotate(rot[:, o], local)
+    return out
+
+
 def segment_world(skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, bone: int, end: int):
-    """(T, 3) world segment vectors of a bone: to ``end``'s head, its own tail (-1), or the
-    tail of bone ``-2 - end`` (a bone starting where this one does)."""
-    if end >= 0:
-        return pos[:, end] - pos[:, bone]
-    other = bone if end == -1 else -2 - end
-    local = skeleton.rest[other, :3, :3].T @ (skeleton.tails[other] - skeleton.heads[other])
-    return pos[:, other] - pos[:, bone] + rot[:, other] @ local
+    """(T, 3) world segment vector of one bone (see ``segments``)."""
+    return segments(skeleton, rot, pos, [bone], [end])[:, 0]
 
 
 def segment_rest(skeleton: Skeleton, bone: int, end: int) -> np.ndarray:

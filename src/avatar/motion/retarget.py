@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from avatar.motion import bonemap, calibrate, contacts, geometry, metrics, timing
-from avatar.motion.pairs import Pair, make_pairs, segment_rest, segment_world
+from avatar.motion.pairs import Pair, make_pairs, segment_rest, segments
 from avatar.rig import quaternion
-from avatar.rig.kinematics import forward
+from avatar.rig.kinematics import levels, rest_quaternions, world_pose
 from avatar.rig.skeleton import Animation, Skeleton
 
 
@@ -57,7 +57,7 @@ class RetargetReport:
 @dataclass(frozen=True)
 class _Source:
     skeleton: Skeleton
-    rot: np.ndarray  # (T, J, 3, 3) world bone rotations
+    rot: np.ndarray  # (T, J, 4) world bone rotations (quaternions)
     pos: np.ndarray  # (T, J, 3) world heads
 
 
@@ -87,50 +87,48 @@ def retarget(
     Returns the target ``Animation`` (T, J_target) and a ``RetargetReport``.
     """
     anim = timing.resample(timing.select(source_animation, frames), fps)
-    src = _forward(source_skeleton, anim)
+    src = _Source(source_skeleton, *world_pose(source_skeleton, anim.rotations, anim.translations))
     smap = bonemap.detect(source_skeleton, source_map, src.pos)
     tmap = bonemap.detect(target_skeleton, target_map)
     pairs = make_pairs(source_skeleton, smap, target_skeleton, tmap, match_names)
-    align = calibrate.offsets(pairs, source_skeleton, src.rot, src.pos, target_skeleton)
-    world = _transfer(pairs, align, src, target_skeleton)
+    src_seg = segments(source_skeleton, src.rot, src.pos, [p.source for p in pairs],
+                       [p.source_end for p in pairs])  # fmt: skip
+    align = calibrate.offsets(pairs, source_skeleton, src.rot, src.pos, target_skeleton, src_seg)
+    world = _transfer(pairs, align, src, src_seg, target_skeleton)
     scale = _leg_length(target_skeleton, tmap) / _leg_length(source_skeleton, smap)
     hips = tmap.bones["hips"]
     root = _root_path(src, smap, tmap, target_skeleton, scale, in_place)
-    feet = contacts.detect(src.pos, smap, anim.fps, _leg_length(source_skeleton, smap))
-    if fix_feet:
+    feet = None
+    if fix_feet or measure:
+        feet = contacts.detect(src.pos, smap, anim.fps, _leg_length(source_skeleton, smap))
+    if feet is not None and fix_feet:
         world = contacts.plant(feet, tmap, target_skeleton, world, root, anim.fps)
     out = _to_local(target_skeleton, world, hips, root, anim.fps)
     quality = None
     if measure:
-        pos = geometry.positions(
-            target_skeleton,
-            world,
-            {hips: root},
-            _ancestors(target_skeleton, [p.target for p in pairs] + [_far(p) for p in pairs]),
-        )
+        ends = [p.target for p in pairs] + [_far(p) for p in pairs]
+        pos = geometry.positions(target_skeleton, world, {hips: root},
+                                 geometry.ancestors(target_skeleton, ends))  # fmt: skip
         quality = metrics.measure(pairs, src, target_skeleton, world, pos, tmap, feet, anim.fps)
     return out, _report(pairs, smap, tmap, source_skeleton, target_skeleton, scale, out, quality)
 
 
-def _forward(skeleton: Skeleton, anim: Animation) -> _Source:
-    world = forward(skeleton, anim.rotations, anim.translations)
-    return _Source(skeleton, world[..., :3, :3], world[..., :3, 3])
-
-
-def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, target: Skeleton) -> np.ndarray:
-    """(T, Jt, 3, 3) target world bone rotations."""
-    world = np.full((src.rot.shape[0], len(target.names), 3, 3), np.nan)
-    for k, p in enumerate(pairs):
-        world[:, p.target] = src.rot[:, p.source] @ align[k]
+def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.ndarray,
+              target: Skeleton) -> np.ndarray:  # fmt: skip
+    """(T, Jt, 4) target world bone rotations (quaternions; NaN: not evaluated)."""
+    world = np.full((src.rot.shape[0], len(target.names), 4), np.nan)
+    world[:, [p.target for p in pairs]] = quaternion.multiply(
+        src.rot[:, [p.source for p in pairs]], align
+    )
     # Bones that only follow their parent keep an identity pose rotation whatever happens
     # above them, so only those that carry driven bones or segment ends are evaluated.
-    needed = _ancestors(target, [p.target for p in pairs] + [_far(p) for p in pairs])
-    free = np.isnan(world[0, :, 0, 0])
-    _inherit(world, target, free & needed)
-    free &= ~_share_chains(world, pairs, target)
-    _aim_chains(world, pairs, src, target)
-    _aim_limbs(world, pairs, src, target)
-    _inherit(world, target, free & needed)  # side branches follow the turned bones
+    needed = geometry.ancestors(target, [p.target for p in pairs] + [_far(p) for p in pairs])
+    free = np.isnan(world[0, :, 0])
+    rest, local = rest_quaternions(target)
+    _inherit(world, target, local, free & needed)
+    free &= ~_share_chains(world, pairs, target, rest)
+    _aim(world, _aims(pairs, src, src_seg, target))
+    _inherit(world, target, local, free & needed)  # side branches follow the turned bones
     return world
 
 
@@ -139,127 +137,121 @@ def _far(p: Pair) -> int:
     return p.target_end if p.target_end >= -1 else -2 - p.target_end
 
 
-def _heads_along(target: Skeleton, world: np.ndarray, path: list[int]) -> np.ndarray:
-    """(T, J, 3) heads of the bones on ``path`` relative to the first one (others NaN)."""
+def _inherit(world: np.ndarray, target: Skeleton, local: np.ndarray, which: np.ndarray) -> None:
+    """Bones in ``which`` keep their rest pose relative to their parent (``local``: (J, 4)
+    rest rotations relative to the parent), a level of the hierarchy at a time."""
+    for group in levels(target.parents, which):
+        p = target.parents[group]
+        if p[0] < 0:
+            world[:, group] = local[group]
+        else:
+            world[:, group] = quaternion.multiply(world[:, p], local[group])
+
+
+@dataclass(frozen=True)
+class _Aim:
+    """Turn ``bones`` (about the first one's head) so that the sum of their world-rotated
+    ``vectors`` (the segment they span) points along ``want`` (T, 3)."""
+
+    bones: list[int]
+    vectors: np.ndarray  # (len(bones), 3) in each bone's frame
+    want: np.ndarray
+
+
+def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton) -> list[_Aim]:
+    """Segment aims in the order they apply: trunk chains (start bone and in-between bones,
+    far end along the source's start-to-end line; exact, the far end depends only on the
+    chain's own rotations), then limb segments (a bone and any bones up to the segment's
+    end) onto the source segment's direction, parents first."""
     off = geometry.offsets(target)
-    pos = np.full(world.shape[:2] + (3,), np.nan)
-    pos[:, path[0]] = 0.0
-    for parent, j in zip(path[:-1], path[1:], strict=True):
-        pos[:, j] = pos[:, parent] + world[:, parent] @ off[j]
-    return pos
-
-
-def _ancestors(skeleton: Skeleton, bones) -> np.ndarray:
-    """(J,) bool: the given bones (negative ones ignored) and all their ancestors."""
-    out = np.zeros(len(skeleton.names), dtype=bool)
-    for j in bones:
-        while j >= 0 and not out[j]:
-            out[j] = True
-            j = int(skeleton.parents[j])
+    by_role = {p.role: p for p in pairs}
+    out = []
+    for start, end in bonemap.CHAINS:
+        a, b = by_role.get(start), by_role.get(end)
+        if a is None or b is None:
+            continue
+        chain = geometry.path(target, a.target, b.target)
+        if len(chain) >= 2:
+            want = src.pos[:, b.source] - src.pos[:, a.source]
+            out.append(_Aim(chain[:-1], off[chain[1:]], want))
+    limbs = sorted(range(len(pairs)), key=lambda k: pairs[k].target)
+    for k in limbs:
+        p = pairs[k]
+        if p.kind == "trunk" or p.role.startswith("="):  # same-named extras keep their twist
+            continue
+        if p.target_end == -1:
+            bones, vectors = [p.target], segment_rest(target, p.target, -1)[None]
+        elif p.target_end < -1:  # the tail of a bone starting at this one's head
+            other = -2 - p.target_end
+            bones = geometry.path(target, p.target, other)
+            tail = segment_rest(target, other, -1)
+            vectors = np.concatenate([off[bones[1:]], tail[None]]) if bones else tail[None]
+        else:
+            bones = geometry.path(target, p.target, p.target_end)[:-1]
+            vectors = off[bones[1:] + [p.target_end]]
+        if bones:
+            out.append(_Aim(bones, vectors, src_seg[:, k]))
     return out
 
 
-def _inherit(world: np.ndarray, target: Skeleton, which: np.ndarray) -> None:
-    """Bones in ``which`` keep their rest pose relative to their parent."""
-    local = target.local_rest()[:, :3, :3]
-    for j in np.flatnonzero(which):
-        parent = target.parents[j]
-        world[:, j] = local[j] if parent < 0 else world[:, parent] @ local[j]
+def _aim(world: np.ndarray, aims: list[_Aim]) -> None:
+    """Apply the aims in order, all those of one wave at once: an aim joins the first wave
+    after every earlier aim that turns one of its bones (disjoint aims commute)."""
+    waves: list[list[_Aim]] = []
+    last: dict[int, int] = {}  # bone -> wave that last turns it
+    for aim in aims:
+        w = 1 + max((last.get(j, -1) for j in aim.bones), default=-1)
+        if w == len(waves):
+            waves.append([])
+        waves[w].append(aim)
+        last.update(dict.fromkeys(aim.bones, w))
+    for wave in waves:
+        bones = np.concatenate([a.bones for a in wave])
+        sizes = [len(a.bones) for a in wave]
+        terms = quaternion.rotate(world[:, bones], np.concatenate([a.vectors for a in wave]))
+        have = np.add.reduceat(terms, np.cumsum([0] + sizes[:-1]), axis=1)
+        turn = quaternion.between(have, np.stack([a.want for a in wave], axis=1))
+        owner = np.repeat(np.arange(len(wave)), sizes)
+        world[:, bones] = quaternion.multiply(turn[:, owner], world[:, bones])
 
 
-def _aim_limbs(world: np.ndarray, pairs: list[Pair], src: _Source, target: Skeleton) -> None:
-    """Turn each limb segment (its bone and any bones up to the segment's end, about the
-    bone's head) onto the source segment's direction, parents first."""
-    off = geometry.offsets(target)
-    for p in sorted(pairs, key=lambda p: p.target):
-        if p.kind == "trunk" or p.role.startswith("="):  # same-named extras keep their twist
-            continue
-        want = segment_world(src.skeleton, src.rot, src.pos, p.source, p.source_end)
-        if p.target_end == -1:
-            have = world[:, p.target] @ segment_rest(target, p.target, p.target_end)
-            path = [p.target]
-        elif p.target_end < -1:  # the tail of a bone starting at this one's head
-            other = -2 - p.target_end
-            path = _path(target, p.target, other)
-            have = segment_world(target, world, _heads_along(target, world, path), p.target,
-                                 p.target_end)  # fmt: skip
-        else:
-            path = _path(target, p.target, p.target_end)[:-1]
-            if not path:
-                continue
-            have = sum(world[:, j] @ off[c] for j, c in zip(path, path[1:] + [p.target_end],
-                                                          strict=True))  # fmt: skip
-        turn = geometry.swing(have, want)
-        world[:, path] = turn[:, None] @ world[:, path]
-
-
-def _share_chains(world: np.ndarray, pairs: list[Pair], target: Skeleton) -> np.ndarray:
+def _share_chains(world: np.ndarray, pairs: list[Pair], target: Skeleton,
+                  rest: np.ndarray) -> np.ndarray:  # fmt: skip
     """Undriven bones strictly between two mapped trunk bones (spine..chest, neck..head)
     turn by a blend of their ends' turns, weighted by position along the chain.
-    Returns (J,) bool: the bones set here."""
+    rest: (J, 4) rest rotations. Returns (J,) bool: the bones set here."""
     driven = {p.role: p.target for p in pairs}
     targets = {p.target for p in pairs}
-    rest = target.rest[:, :3, :3]
     done = np.zeros(len(target.names), dtype=bool)
     for start, end in bonemap.CHAINS:
         if start not in driven or end not in driven:
             continue
-        chain = _path(target, driven[start], driven[end])
+        chain = geometry.path(target, driven[start], driven[end])
         if len(chain) < 3:
             continue
         heads = target.heads[chain]
         cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(heads, axis=0), axis=1))])
         u = cum / max(cum[-1], 1e-9)
-        q0 = quaternion.from_matrix(world[:, chain[0]] @ rest[chain[0]].T)
-        q1 = quaternion.from_matrix(world[:, chain[-1]] @ rest[chain[-1]].T)
-        for i, j in enumerate(chain[1:-1], 1):
-            if j in targets:
-                continue
-            turn = quaternion.slerp(q0, q1, np.full(len(q0), u[i]))
-            world[:, j] = quaternion.to_matrix(turn) @ rest[j]
-            done[j] = True
+        inner = [i for i in range(1, len(chain) - 1) if chain[i] not in targets]
+        if not inner:
+            continue
+        ends = [quaternion.multiply(world[:, chain[i]], quaternion.conjugate(rest[chain[i]]))
+                for i in (0, -1)]  # fmt: skip
+        weights = np.broadcast_to(u[inner], (len(world), len(inner)))
+        turn = quaternion.slerp(ends[0][:, None], ends[1][:, None], weights)
+        bones = [chain[i] for i in inner]
+        world[:, bones] = quaternion.multiply(turn, rest[bones])
+        done[bones] = True
     return done
-
-
-def _aim_chains(world: np.ndarray, pairs: list[Pair], src: _Source, target: Skeleton) -> None:
-    """Turn each trunk chain (start bone and in-between bones, about the start's head) so
-    the chain's far end lies along the source's start-to-end segment. Exact: the far end
-    depends only on the chain's own rotations."""
-    by_role = {p.role: p for p in pairs}
-    off = geometry.offsets(target)
-    for start, end in bonemap.CHAINS:
-        a, b = by_role.get(start), by_role.get(end)
-        if a is None or b is None:
-            continue
-        chain = _path(target, a.target, b.target)
-        if len(chain) < 2:
-            continue
-        reach = np.zeros((world.shape[0], 3))
-        for j, child in zip(chain[:-1], chain[1:], strict=True):
-            reach += world[:, j] @ off[child]
-        want = src.pos[:, b.source] - src.pos[:, a.source]
-        turn = geometry.swing(reach, want)
-        world[:, chain[:-1]] = turn[:, None] @ world[:, chain[:-1]]
-
-
-def _path(skeleton: Skeleton, top: int, bottom: int) -> list[int]:
-    """Bones from ``top`` down to ``bottom`` (inclusive); [] when not an ancestor."""
-    path = [bottom]
-    while path[-1] != top:
-        parent = int(skeleton.parents[path[-1]])
-        if parent < 0:
-            return []
-        path.append(parent)
-    return path[::-1]
 
 
 def _leg_length(skeleton: Skeleton, bmap: bonemap.BoneMap) -> float:
     """Mean hip-to-ankle length along thigh and shin (metres); body height / 2 fallback."""
     total = []
     for side in ("L", "R"):
-        b = [bmap.bones.get(f"{r}.{side}") for r in ("thigh", "shin", "foot")]
-        if None not in b:
-            h = skeleton.heads[b]
+        roles = [f"{r}.{side}" for r in ("thigh", "shin", "foot")]
+        if all(r in bmap.bones for r in roles):
+            h = skeleton.heads[[bmap.bones[r] for r in roles]]
             total.append(np.linalg.norm(h[1] - h[0]) + np.linalg.norm(h[2] - h[1]))
     if total:
         return float(np.mean(total))
@@ -281,32 +273,34 @@ def _root_path(src: _Source, smap, tmap, target: Skeleton, scale: float, in_plac
 
 
 def _to_local(target: Skeleton, world: np.ndarray, hips: int, root: np.ndarray, fps: float):
-    """World rotations (T, J, 3, 3) and hips heads (T, 3) -> Blender pose-bone values.
+    """World rotations (T, J, 4) and hips heads (T, 3) -> Blender pose-bone values.
 
     Bones left unevaluated (NaN: they only follow their parent) get the identity.
     """
     t, j = world.shape[:2]
-    posed = ~np.isnan(world[0, :, 0, 0])
+    posed = ~np.isnan(world[0, :, 0])
     parents = target.parents
     free = ~posed | ((parents >= 0) & ~posed[np.maximum(parents, 0)])
     bones = np.flatnonzero(~free)
-    local_rest = target.local_rest()[bones, :3, :3]
+    rest, local_rest = rest_quaternions(target)
     p = parents[bones]
-    parent_world = np.where((p >= 0)[None, :, None, None], world[:, np.maximum(p, 0)], np.eye(3))
-    base = parent_world @ local_rest  # each bone's frame before its own pose rotation
+    parent_world = world[:, np.maximum(p, 0)]
+    parent_world[:, p < 0] = (1.0, 0.0, 0.0, 0.0)
+    base = quaternion.multiply(parent_world, local_rest[bones])  # frame before the pose
+    local = quaternion.multiply(quaternion.conjugate(base), world[:, bones])
     rotations = np.zeros((t, j, 4))
     rotations[..., 0] = 1.0
-    rotations[:, bones] = quaternion.from_matrix(np.swapaxes(base, -1, -2) @ world[:, bones])
+    rotations[:, bones] = np.where(local[..., :1] < 0, -local, local)  # w >= 0
     translations = np.zeros((t, j, 3))
     ph = parents[hips]
     if ph < 0:
-        head0, frame0 = target.heads[hips], target.rest[hips, :3, :3]
+        head0, frame0 = target.heads[hips], rest[hips]
     else:
-        anc = _ancestors(target, [ph])
+        anc = geometry.ancestors(target, [ph])
         pos = geometry.positions(target, world, {}, anc)
-        head0 = pos[:, ph] + world[:, ph] @ geometry.offsets(target)[hips]
-        frame0 = world[:, ph] @ target.local_rest()[hips, :3, :3]
-    translations[:, hips] = np.einsum("...ba,...b->...a", frame0, root - head0)
+        head0 = pos[:, ph] + quaternion.rotate(world[:, ph], geometry.offsets(target)[hips])
+        frame0 = quaternion.multiply(world[:, ph], local_rest[hips])
+    translations[:, hips] = quaternion.rotate(quaternion.conjugate(frame0), root - head0)
     return Animation(rotations, translations, float(fps), target.names)
 
 
