@@ -81,8 +81,11 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--pose",
         metavar="NAME|FILE",
-        help="static pose: rest, a-pose, t-pose, or a .bvh file (its first frame)",
+        help="static pose: rest, a-pose, t-pose (any rig), a pose of the library "
+        "(see `avatar poses list`), or a .bvh (first frame) or MPFB .json pose file",
     )
+    p.add_argument("--pose-folder", action="append", default=[], metavar="DIR",
+                   help="also look for poses in this folder; repeatable")  # fmt: skip
     p.add_argument(
         "--wear",
         action="append",
@@ -131,6 +134,17 @@ def _add_optional(sub: argparse._SubParsersAction) -> None:
                        "an Avatar rig; writes one BVH per clip and reports quality.")  # fmt: skip
     add_retarget_arguments(p)
     p.set_defaults(run=cli_retarget)
+    from avatar.motion.cli import cli_poses_list
+
+    poses = sub.add_parser("poses", help="the pose library",
+                           description="List built-in poses and the poses in user folders "
+                           "(single-frame .bvh, MPFB .json; also $AVATAR_POSES_PATH).")  # fmt: skip
+    poses_sub = poses.add_subparsers(title="commands", metavar="COMMAND")
+    p = poses_sub.add_parser("list", help="list poses (built-in and user folders)")
+    p.add_argument("--search", metavar="TEXT", help="only poses matching every word")
+    p.add_argument("--folder", action="append", default=[], metavar="DIR",
+                   help="also scan this folder (MakeHuman data/poses); repeatable")  # fmt: skip
+    p.set_defaults(run=cli_poses_list)
     from avatar.clothes.library import cli_clothes_list
 
     clothes = sub.add_parser("clothes", help="the clothes library",
@@ -178,8 +192,8 @@ def run_create(args: argparse.Namespace) -> int:
         log.info("measurements: %s", ", ".join(f"{k} {v * 100:.1f} cm" for k, v in got.items()))
         human = Human(solved, human.recipe.rig, model, human.recipe)
     human = _dress(human, args.wear)
-    animation = _animation(human, args)
-    path = save(human, args.output, animation, args.expressions, args.hide_covered)
+    animation, name = _animation(human, args)
+    path = save(human, args.output, animation, args.expressions, args.hide_covered, name)
     log.info("wrote %s", path)
     if args.render:
         from avatar.blender.picture import render_human
@@ -199,22 +213,25 @@ def _dress(human, wear: list[str]):
 
 
 def _animation(human, args: argparse.Namespace):
+    """(the Animation or None, its name for the file: the clip's stem, the motion or pose)."""
     from avatar.motion.procedural import MOTIONS
 
     if args.motion in MOTIONS:
-        return MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0)
-    clip = args.motion or (args.pose if args.pose and args.pose.lower().endswith(".bvh") else None)
-    if clip:
-        from avatar.motion.cli import motion_for
+        return MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0), args.motion
+    if args.motion:
+        from pathlib import Path
 
-        if not args.motion:  # a BVH pose: its first frame
-            args = argparse.Namespace(**{**vars(args), "frames": "0:1"})
-        animation, report = motion_for(human.skeleton, clip, args)
+        from avatar.motion.cli import motion_for, report_floor
+
+        animation, report = motion_for(human.skeleton, args.motion, args)
         log.info("%s", report.summary())
-        return animation
+        report_floor(human, animation)
+        return animation, Path(args.motion).stem
     if args.pose:
-        return human.pose(args.pose)
-    return None
+        from pathlib import Path
+
+        return human.pose(args.pose, args.pose_folder), Path(args.pose).stem
+    return None, None
 
 
 def run_info(args: argparse.Namespace) -> int:

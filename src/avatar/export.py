@@ -31,9 +31,10 @@ def _obj(human: Human, path: Path, animation: Animation | None, options: dict) -
 def _gltf(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.io import gltf
 
-    gltf.write(
-        path, human.parts(**options), human.skeleton, [animation] if animation is not None else []
-    )
+    options = dict(options)
+    name = options.pop("animation_name", None) or "animation"
+    clips = {name: animation} if animation is not None else {}
+    gltf.write(path, human.parts(**options), human.skeleton, clips)
 
 
 def _blender(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
@@ -63,11 +64,14 @@ def save(
     animation: Animation | None = None,
     expressions: bool = False,
     hide_covered: bool = False,
+    animation_name: str | None = None,
 ) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
     expressions: include the 52 ARKit face units as morph targets (glTF only).
     hide_covered: leave out skin that garments cover entirely (glTF; default: keep it).
+    animation_name: the glTF animation's name, e.g. the clip's file stem (default
+        "animation"); players and Blender's importer show it as the clip/action name.
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
     (the skin mesh), .mhm (MakeHuman character file), .fbx/.usd/.blend (through Blender).
     """
@@ -76,5 +80,7 @@ def save(
     if writer is None:
         raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    writer(human, path, animation, {"expressions": expressions, "hide_covered": hide_covered})
+    options = {"expressions": expressions, "hide_covered": hide_covered,
+               "animation_name": animation_name}  # fmt: skip
+    writer(human, path, animation, options)
     return path

@@ -6,7 +6,7 @@ human.mesh, human.skeleton, human.weights, human.posed(animation)
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
@@ -17,7 +17,7 @@ from avatar.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.errors import ParameterError, unknown_name
 from avatar.mesh import Mesh
-from avatar.rig import kinematics, poses, skinning
+from avatar.rig import kinematics, skinning
 from avatar.rig.placement import RigDefinition
 from avatar.rig.skeleton import Animation, Skeleton
 from avatar.rig.skinning import SkinWeights
@@ -134,11 +134,16 @@ class Human:
         body of the rig: weights do not depend on the shape)."""
         return self.model.skin_weights(self.recipe.rig, tuple(self.skeleton.names))
 
-    def pose(self, name: str) -> Animation:
-        """A named pose ("rest", "a-pose", "t-pose") for this rig."""
-        return poses.named_pose(
-            self.skeleton, self.recipe.rig, name, self.model.assets.meta["poses"]
-        )
+    def pose(self, name: str, folders: Sequence[str] = ()) -> Animation:
+        """A pose for this rig (1 frame): "rest", "a-pose", "t-pose" (any rig, from its
+        geometry), a pose of the library (``folders``, ``$AVATAR_POSES_PATH``), or a
+        ``.bvh``/MPFB ``.json`` pose file; see ``avatar.motion.poselib``."""
+        from avatar.motion import poselib
+
+        def reference() -> Skeleton:  # MPFB pose files name the MakeHuman default rig's bones
+            return Human(self.params, "default", self.model).skeleton
+
+        return poselib.load(name, self.skeleton, folders, reference)
 
     def posed(
         self, animation: Animation, frames: slice | None = None, method: str = "lbs"

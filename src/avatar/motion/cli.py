@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 from pathlib import Path
 
 from avatar.errors import ParameterError
@@ -18,6 +19,8 @@ from avatar.io import bvh
 from avatar.motion import timing
 from avatar.motion.retarget import RetargetReport, retarget
 from avatar.rig.skeleton import Animation, Skeleton
+
+log = logging.getLogger(__name__)
 
 
 def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
@@ -93,3 +96,23 @@ def _row(report: RetargetReport) -> dict:
     if report.quality is not None:
         row.update(report.quality.as_dict())
     return row
+
+
+def report_floor(human, animation: Animation, most_frames: int = 300) -> None:
+    """Log how the skinned body meets the floor over ``animation`` (``floor.measure``)."""
+    from avatar.motion import floor
+
+    log.info("%s", floor.measure_human(human, animation, most_frames).summary())
+
+
+def cli_poses_list(args: argparse.Namespace) -> int:
+    """``avatar poses list``: built-in poses and pose files in user folders."""
+    from avatar.motion import poselib
+
+    words = (args.search or "").lower().split()
+    for entry in poselib.list_poses(args.folder):
+        text = f"{entry.name} {entry.source} {entry.description}".lower()
+        if all(w in text for w in words):
+            where = f"  {entry.path}" if entry.path else ""
+            print(f"{entry.name:24s} {entry.source:9s} {entry.description}{where}")
+    return 0

@@ -1,11 +1,15 @@
-"""Static poses: MPFB's T-pose files and poses as bone-name -> rotation maps."""
+"""Static poses: MPFB's pose files, poses as bone-name -> rotation maps, and re-expressing
+an animation over a different rest pose (``rebase``).
+
+Geometric poses for any rig (T-pose, A-pose) and the pose library are in
+``avatar.motion.poselib``; they need bone roles.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from avatar.errors import unknown_name
-from avatar.rig import quaternion
+from avatar.rig import kinematics, quaternion
 from avatar.rig.skeleton import Animation, Skeleton
 
 # MPFB stores pose-bone Euler angles in Blender's default rotation mode.
@@ -38,12 +42,34 @@ def from_euler_map(
     return Animation(rot, trans, pose.fps, skeleton.names)
 
 
-def named_pose(skeleton: Skeleton, rig: str, name: str, poses: dict[str, dict]) -> Animation:
-    """A named pose of the asset library ("rest", "a-pose" or "t-pose") for ``rig``."""
-    if name in ("rest", "a-pose"):  # MakeHuman rigs rest in an A-pose
-        return rest_pose(skeleton)
-    library = poses.get(rig) or poses.get("default", {})
-    if name not in library:
-        raise unknown_name("pose", name, ["rest", "a-pose", *library])
-    data = library[name]
-    return from_euler_map(skeleton, data["bone_rotations"], data.get("bone_translations"))
+def inverse(pose: Animation) -> Animation:
+    """The pose that undoes ``pose`` bone by bone: basis T(t) R(q) -> R(q)^-1 T(-t).
+
+    With ``rebase``: ``rebase(*rebase(skeleton, anim, pose), inverse(pose))`` gives back
+    ``skeleton`` and ``anim``. pose: one frame (1, J) or as many frames as needed.
+    """
+    back = quaternion.conjugate(pose.rotations)
+    moved = -quaternion.rotate(back, pose.translations)
+    return Animation(back, moved, pose.fps, pose.bone_names)
+
+
+def rebase(skeleton: Skeleton, animation: Animation, pose: Animation) -> tuple[Skeleton, Animation]:
+    """The same motion over a new rest pose: ``pose`` (its first frame) becomes the rest.
+
+    skeleton: (J bones) the rig; animation: (T, J) motion on it; pose: (1, J) the new rest
+    (e.g. ``poselib.built_in(skeleton, "t-pose")``).
+    Returns the skeleton whose rest matrices and tails are the posed ones, and the motion
+    re-expressed on it: every bone's world matrix in every frame is unchanged. Per bone,
+    with the pose's basis P = T(p_t) R(p_q): new local rest = old local rest @ P and new
+    basis = P^-1 @ old basis, i.e. rotation p_q^-1 q and location p_q^-1 (t - p_t).
+    """
+    p_q, p_t = pose.rotations[0], pose.translations[0]
+    world = kinematics.forward(skeleton, p_q[None], p_t[None])[0]
+    tails_local = np.einsum("jab,jb->ja", np.linalg.inv(skeleton.rest)[:, :3, :3],
+                            skeleton.tails - skeleton.heads)  # fmt: skip
+    tails = world[:, :3, 3] + np.einsum("jab,jb->ja", world[:, :3, :3], tails_local)
+    rested = Skeleton(skeleton.names, skeleton.parents, world, tails, dict(skeleton.extra))
+    back = quaternion.conjugate(p_q)
+    rotations = quaternion.multiply(back, animation.rotations)
+    translations = quaternion.rotate(back, animation.translations - p_t)
+    return rested, Animation(rotations, translations, animation.fps, animation.bone_names)
