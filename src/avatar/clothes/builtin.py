@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar.clothes import fabrics, hair, textures
+from avatar.clothes import fabrics, face, hair, textures
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -150,10 +150,10 @@ SPECS = [
     Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
-    Spec("hair-long", "hair", lambda b: join([hair.scalp(b, 0.006), hair.helper_cards(b)]), "hair", "blond hair", 0.006, 70, ("hair", "long")),  # noqa: E501
-    Spec("hair-ponytail", "hair", lambda b: join([hair.scalp(b, 0.004, front=0.045), hair.ponytail(b)]), "hair", "black hair", 0.004, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
-    Spec("eyebrows", "face", hair.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
-    Spec("eyelashes", "face", lambda b: hair.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
+    Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 500, (0.1, 0.16), 0.02, (0.004, 0.012), 6), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
+    Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 500, (0.08, 0.14), 0.02, (0.003, 0.008), 6), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
+    Spec("eyebrows", "face", face.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
+    Spec("eyelashes", "face", lambda b: face.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
 ]  # fmt: skip
 
 EYELASH_GROUPS = (

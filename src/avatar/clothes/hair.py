@@ -14,9 +14,7 @@ from avatar.clothes.authoring import (
     Piece,
     bound,
     cut,
-    join,
     orient_outward,
-    single_references,
 )
 from avatar.clothes.shell import boundary_edges
 from avatar.mesh import Mesh
@@ -131,6 +129,18 @@ def flow_crown(crown_offset=(0.0, 0.035, 0.1), sweep: float = 0.6):
     return flow
 
 
+def flow_parted(front: float = -0.11, crown: float = 0.03):
+    """A hair flow field combed away from a centre parting (y from ``front`` to ``crown``
+    relative to the skull centre, along the top of the head)."""
+
+    def flow(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+        y = np.clip(points[:, 1] - centre[1], front, crown) + centre[1]
+        part = np.stack([np.zeros(len(points)), y, np.full(len(points), eye_z + 0.2)], 1)
+        return points - part
+
+    return flow
+
+
 def flow_tied(tie_offset=(0.0, 0.07, 0.0)):
     """A hair flow field drawn back to a tie point behind the head."""
 
@@ -173,29 +183,8 @@ def grow_cards(
                             0.002 + (top - 0.002) * (k / segments) ** 0.7)  # fmt: skip
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
-    side = np.cross(
-        body.outward(path.reshape(-1, 3)).reshape(path.shape), np.gradient(path, axis=1)
-    )
-    side /= np.linalg.norm(side, axis=-1, keepdims=True)
-    half = (
-        (width / 2)
-        * rng.uniform(0.7, 1.2, count)[:, None, None]
-        * np.linspace(1, 0.7, segments + 1)[None, :, None]
-    )
-    verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2(K+1), 3)
-    n = segments + 1
-    k = np.arange(segments)
-    quad = np.stack([k, k + 1, n + k + 1, n + k], 1)
-    faces = (quad[None] + (2 * n * np.arange(count))[:, None, None]).reshape(-1, 4)
-    u0 = rng.uniform(0, 1, count)[:, None]
-    t = np.linspace(0, 1, n)[None, :]
-    uv = np.concatenate(
-        [np.stack(np.broadcast_arrays(u0, 0.5 * (1 - t)), -1),
-         np.stack(np.broadcast_arrays(u0 + 0.12, 0.5 * (1 - t)), -1)], 1
-    )  # fmt: skip
-    mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
-    mesh = Mesh(mesh.vertices, mesh.faces, uv.reshape(-1, 2).astype(np.float32), mesh.faces.copy())
-    return bound(body, mesh, body.skin_faces)
+    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    return _card_piece(body, path, normal, width, rng)
 
 
 def _scatter(body: AuthoringBody, keep: np.ndarray, count: int, rng) -> np.ndarray:
@@ -226,70 +215,128 @@ def _above_skin(body: AuthoringBody, points: np.ndarray, height: np.ndarray) -> 
     return on + np.asarray(height)[:, None] * n
 
 
-def helper_cards(body: AuthoringBody, layers=(0.006, 0.014, 0.022)) -> Piece:
-    """Long hair: MakeHuman's ``helper-hair`` strips, repeated in layers for volume, with
-    strand UVs (v 0.5 at the roots down to 0 at the tips)."""
-    src = body.group_faces("helper-hair")
-    centre, eye_z = eye_level(body)
-    mid = body.vertices[src].mean(axis=1)
-    # MakeHuman's strips include fringe locks over the face; a style you can see through keeps
-    # only those beside and behind the eyes.
-    src = src[~((mid[:, 1] < centre[1] - 0.02) & (mid[:, 2] < eye_z + 0.04))]
-    used, inv = np.unique(src, return_inverse=True)
-    pts = body.vertices[used]
-    local = inv.reshape(src.shape).astype(np.int32)
-    top, low = pts[:, 2].max(), pts[:, 2].min()
-    meshes = []
-    for k, ease in enumerate(layers):
-        p = pts + ease * body.outward(pts)
-        rel = p - centre
-        u = (np.arctan2(rel[:, 0], -rel[:, 1]) / np.pi + 1) * 3.0 + 0.37 * k
-        v = 0.5 * (p[:, 2] - low) / (top - low)
-        meshes.append((p, np.stack([u, v], 1)))
-    verts = np.concatenate([m[0] for m in meshes]).astype(np.float32)
-    uvs = np.concatenate([m[1] for m in meshes]).astype(np.float32)
-    faces = np.concatenate([local + i * len(pts) for i in range(len(layers))])
-    mesh = orient_outward(body, verts, faces)
-    mesh = Mesh(mesh.vertices, mesh.faces, uvs, mesh.faces.copy())
+def guides(body: AuthoringBody, samples: int = 16, behind: bool = True) -> np.ndarray:
+    """(G, samples, 3) guide curves of long hair from MakeHuman's ``helper-hair`` ribbons
+    (which its targets reshape with every body): each ribbon's centre line from the crown
+    to the tip, resampled evenly by length. The short fringe ribbons over the face are left
+    out, and with ``behind`` those falling in front of the shoulders; the curves are ordered
+    by their direction around the head."""
+    from avatar.clothes.face import strip_uvs
+
+    faces = body.group_faces("helper-hair")
+    centre, eye_z = head_frame(body)
+    top = centre + [0, 0, 0.15]
+    curves = []
+    for ribbon in _components(faces):
+        used, local = np.unique(ribbon, return_inverse=True)
+        points = body.vertices[used]
+        if points[:, 2].min() > eye_z - 0.15:  # a lock over the face, not long hair
+            continue
+        if behind and points[points[:, 2].argmin(), 1] < centre[1]:  # falls over the chest
+            continue
+        mesh = Mesh(points.astype(np.float32), local.reshape(ribbon.shape).astype(np.int32))
+        row = np.round(strip_uvs(mesh, top)[:, 0] * (len(points) // 2 - 1)).astype(int)
+        line = np.stack([points[row == r].mean(0) for r in range(row.max() + 1)])
+        curves.append(_resample(line, samples))
+    out = np.stack(curves)
+    return out[np.argsort(np.arctan2(out[:, -1, 0], -(out[:, -1, 1] - centre[1])))]
+
+
+def _components(faces: np.ndarray) -> list[np.ndarray]:
+    """The faces of each edge-connected piece of a face set."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    used, local = np.unique(faces, return_inverse=True)
+    local = local.reshape(faces.shape)
+    a, b = local.reshape(-1), np.roll(local, -1, axis=1).reshape(-1)
+    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(used), len(used)))
+    _, label = connected_components(graph, directed=False)
+    piece = label[local[:, 0]]
+    return [faces[piece == k] for k in np.unique(piece)]
+
+
+def _resample(line: np.ndarray, samples: int) -> np.ndarray:
+    """(samples, 3) points evenly spaced by arc length along a polyline (P, 3)."""
+    along = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))])
+    t = np.linspace(0, along[-1], samples)
+    return np.stack([np.interp(t, along, line[:, k]) for k in range(3)], 1)
+
+
+def long_cards(
+    body: AuthoringBody,
+    count: int = 420,
+    width: float = 0.026,
+    layers=(0.004, 0.024),
+    seed: int = 1,
+) -> Piece:
+    """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
+    stacked at random heights between ``layers`` (m) off the guides, of random length.
+
+    Neighbours are only blended around the back and sides: never across the face.
+    UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
+    """
+    rng = np.random.default_rng([seed, count])
+    g = guides(body)
+    pairs = [(i, i + 1) for i in range(len(g) - 1)
+             if np.linalg.norm(g[i, -1] - g[i + 1, -1]) < 0.15]  # fmt: skip
+    pick = rng.integers(0, len(pairs), count)
+    w = rng.uniform(0, 1, count)[:, None, None]
+    first, second = np.array(pairs).T
+    path = (1 - w) * g[first[pick]] + w * g[second[pick]]  # (N, K, 3)
+    k = path.shape[1]
+    # Shorter cards end higher up: sample each path to a random fraction of its length.
+    at = np.linspace(0, 1, k)[None, :] * rng.uniform(0.75, 1.0, count)[:, None] * (k - 1)
+    lo = np.minimum(np.floor(at).astype(int), k - 2)
+    frac = (at - lo)[..., None]
+    n = np.arange(count)[:, None]
+    path = (1 - frac) * path[n, lo] + frac * path[n, lo + 1]
+    t = np.linspace(0, 1, k)[None, :, None]
+    height = rng.uniform(*layers, count)[:, None, None] * np.sqrt(t)
+    flat = path.reshape(-1, 3)
+    normal = body.outward(flat).reshape(path.shape)
+    path = path + height * normal
+    return _card_piece(body, path, normal, width, rng)
+
+
+def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng) -> Piece:
+    """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin."""
+    count, k = path.shape[:2]
+    side = np.cross(normal, np.gradient(path, axis=1))
+    side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
+    half = (width / 2) * rng.uniform(0.7, 1.2, count)[:, None, None]
+    half = half * np.linspace(1, 0.7, k)[None, :, None]
+    verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2K, 3)
+    j = np.arange(k - 1)
+    quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
+    faces = (quad[None] + (2 * k * np.arange(count))[:, None, None]).reshape(-1, 4)
+    u0 = rng.uniform(0, 1, count)[:, None]
+    v = 0.5 * (1 - np.linspace(0, 1, k))[None, :]
+    left = np.stack(np.broadcast_arrays(u0, v), -1)
+    uv = np.concatenate([left, left + [0.12, 0.0]], 1).reshape(-1, 2).astype(np.float32)
+    mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
+    mesh = Mesh(mesh.vertices, mesh.faces, uv, mesh.faces.copy())
     return bound(body, mesh, body.skin_faces)
 
 
-def ponytail(body: AuthoringBody, length: float = 0.3, cards: int = 4, rows: int = 12) -> Piece:
-    """A tied-back tail: crossed strand cards hanging from the back of the head."""
-    centre, eye_z = eye_level(body)
+def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 60, seed: int = 2) -> Piece:
+    """A tied-back tail: strand cards around a spine hanging from the back of the head,
+    gathered tight at the tie, fuller below it and tapering to the tips."""
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
     back = body.vertices[:SKIN][body.part[:SKIN] == "head"][:, 1].max()
-    root = np.array([0.0, back + 0.01, eye_z + 0.02])
-    t = np.linspace(0, 1, rows + 1)
+    root = np.array([0.0, back + 0.005, eye_z + 0.02])
+    k = 13
+    t = np.linspace(0, 1, k)
     # The tail falls back and down, then down along the upper back.
     spine = root + np.stack([0 * t, 0.05 * np.sin(t * np.pi / 2) + 0.03 * t, -length * t], 1)
-    width = 0.045 * (1 - 0.6 * t) + 0.01
-    verts, uvs, faces = [], [], []
-    for c in range(cards):
-        angle = np.pi * c / cards
-        side = np.array([np.cos(angle), np.sin(angle) * 0.5, 0.0])
-        start = len(verts) and sum(len(x) for x in verts)
-        left = spine - width[:, None] * side
-        right = spine + width[:, None] * side
-        verts.append(np.concatenate([left, right]))
-        u0 = 0.3 * c
-        uvs.append(
-            np.concatenate(
-                [
-                    np.stack([np.full_like(t, u0), 0.5 * (1 - t)], 1),
-                    np.stack([np.full_like(t, u0 + 0.25), 0.5 * (1 - t)], 1),
-                ]
-            )
-        )
-        i = np.arange(rows)
-        n = rows + 1
-        faces.append(np.stack([i, i + 1, n + i + 1, n + i], 1) + start)
-    mesh = Mesh(
-        np.concatenate(verts).astype(np.float32),
-        np.concatenate(faces).astype(np.int32),
-        np.concatenate(uvs).astype(np.float32),
-        np.concatenate(faces).astype(np.int32),
-    )
-    return bound(body, mesh, body.skin_faces)
+    radius = 0.008 + 0.022 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.5 * t)
+    angle = rng.uniform(0, 2 * np.pi, count)[:, None] + rng.normal(0, 0.3, count)[:, None] * t
+    reach = rng.uniform(0.8, 1.05, count)[:, None]
+    radial = np.stack([np.cos(angle), np.sin(angle) * 0.7, np.zeros_like(angle)], -1)
+    path = spine[None] * np.array([1, 1, 0]) + radial * (radius * reach)[..., None]
+    path[..., 2] = root[2] - length * t[None, :] * reach
+    return _card_piece(body, path, radial, 0.02, rng)
 
 
 def brim(body: AuthoringBody, cap: Piece, reach: float = 0.07) -> Piece:
@@ -330,81 +377,3 @@ def orient_up(mesh: Mesh) -> Mesh:
     fuv = mesh.face_uvs.copy()
     fuv[flip] = fuv[flip][:, [2, 1, 0, 3]]
     return Mesh(mesh.vertices, faces, mesh.uvs, fuv)
-
-
-def eyebrows(body: AuthoringBody, inner=0.019, outer=0.03, low=0.006, height=0.022) -> Piece:
-    """Two brow patches on the skin above the eyes, each with UVs spanning the eyebrow
-    texture: u from ``inner`` metres inside the eye centre (0) to ``outer`` outside it (1),
-    v from ``low`` above the eye centre over ``height`` metres. The texture's alpha draws
-    the brow's shape and hairs; the patch is only where they may be."""
-    faces = body.skin_faces
-    pieces = []
-    for group in ("helper-l-eye", "helper-r-eye"):
-        eye = body.centre(group)
-        side = np.sign(eye[0])
-
-        def uv(p, eye=eye, side=side):
-            u = (side * (p[..., 0] - eye[0]) + inner) / (inner + outer)
-            return np.stack([u, (p[..., 2] - eye[2] - low) / height], -1)
-
-        corners = uv(body.vertices[faces])  # (F, 4, 2)
-        inside = ((corners > 0) & (corners < 1)).all(axis=(1, 2))
-        keep = inside & (body.vertices[faces][:, :, 1].mean(1) < eye[1])
-        mesh = cut(body, faces, keep, 0.0006)
-        mesh = per_corner(mesh, uv(mesh.vertices[mesh.faces]).reshape(-1, 2).astype(np.float32))
-        pieces.append(bound(body, mesh, faces))
-    return join(pieces)
-
-
-def eyelashes(body: AuthoringBody, groups: tuple[str, ...]) -> Piece:
-    """The base mesh's eyelash helper strips (single-vertex references, as MakeHuman binds
-    its eyelash proxies), with strip UVs: u along the lid, v from the lid margin (0) to the
-    lash tips, so the lash texture's strands run from root to tip (upper lids over v in
-    [0.5, 1], lower lids over [0, 0.5])."""
-    pieces = []
-    for group in groups:
-        piece = single_references(body, group)
-        eye = body.centre(group.replace("eyelashes-1", "eye").replace("eyelashes-2", "eye"))
-        uv = strip_uvs(piece.mesh, eye)
-        uv[:, 1] = 0.5 * uv[:, 1] + (0.5 if group.endswith("-2") else 0.0)  # -2: upper lid
-        mesh = Mesh(piece.mesh.vertices, piece.mesh.faces, uv, piece.mesh.faces.copy())
-        pieces.append(Piece(mesh, piece.binding))
-    return join(pieces)
-
-
-def strip_uvs(mesh: Mesh, eye: np.ndarray) -> np.ndarray:
-    """(V, 2) float32 UVs of a quad-grid strip: v is the hop distance from the long boundary
-    side nearest ``eye`` (the root side), u the hop distance from one short side, both
-    scaled to [0, 1]."""
-    edges, _ = boundary_edges(mesh.faces)
-    following = dict(zip(edges[:, 0].tolist(), edges[:, 1].tolist(), strict=True))
-    loop = [int(edges[0, 0])]
-    while following[loop[-1]] != loop[0]:
-        loop.append(following[loop[-1]])
-    uses = np.bincount(mesh.faces.ravel(), minlength=len(mesh.vertices))
-    corners = [i for i, v in enumerate(loop) if uses[v] == 1]
-    loop = loop[corners[0] :] + loop[: corners[0]]  # start at a corner
-    corners = [c - corners[0] for c in corners] + [len(loop)]
-    sides = [loop[a : b + 1] if b < len(loop) else loop[a:] + loop[:1]
-             for a, b in zip(corners[:-1], corners[1:], strict=True)]  # fmt: skip
-    long_sides = sorted(sides, key=len)[2:]
-    root = min(long_sides, key=lambda s: np.linalg.norm(mesh.vertices[s] - eye, axis=1).mean())
-    short = sorted(sides, key=len)[0]
-    v = _hops(mesh.faces, len(mesh.vertices), root)
-    u = _hops(mesh.faces, len(mesh.vertices), short)
-    return np.stack([u / u.max(), v / v.max()], 1).astype(np.float32)
-
-
-def _hops(faces: np.ndarray, count: int, sources: list[int]) -> np.ndarray:
-    """(V,) number of edge hops from the nearest source vertex (inf where unreachable)."""
-    a = faces.reshape(-1)
-    b = np.roll(faces, -1, axis=1).reshape(-1)
-    dist = np.full(count, np.inf)
-    dist[sources] = 0
-    while True:
-        new = dist.copy()
-        np.minimum.at(new, b, dist[a] + 1)
-        np.minimum.at(new, a, dist[b] + 1)
-        if np.array_equal(new, dist):
-            return dist
-        dist = new
