@@ -221,16 +221,22 @@ def _animation(human, args: argparse.Namespace):
     if args.motion:
         from pathlib import Path
 
-        from avatar.motion.cli import motion_for, report_floor
+        from avatar.motion.cli import motion_for, on_floor
 
         animation, report = motion_for(human.skeleton, args.motion, args)
         log.info("%s", report.summary())
-        report_floor(human, animation)
+        animation, _ = on_floor(human, animation, args)
         return animation, Path(args.motion).stem
     if args.pose:
         from pathlib import Path
 
-        return human.pose(args.pose, args.pose_folder), Path(args.pose).stem
+        from avatar.motion.cli import on_floor
+        from avatar.motion.poselib import BUILT_IN
+
+        pose = human.pose(args.pose, args.pose_folder)
+        if args.pose.lower() not in BUILT_IN:  # a pose file: stand it on the floor
+            pose, _ = on_floor(human, pose, args)
+        return pose, Path(args.pose).stem
     return None, None
 
 

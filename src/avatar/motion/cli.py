@@ -14,6 +14,8 @@ import json
 import logging
 from pathlib import Path
 
+import numpy as np
+
 from avatar.errors import ParameterError
 from avatar.io import bvh
 from avatar.motion import timing
@@ -29,6 +31,9 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fps", type=float, help="output frame rate (default: the clip's)")
     parser.add_argument("--in-place", action="store_true", help="remove horizontal root motion")
     parser.add_argument("--no-foot-fix", action="store_true", help="skip contact planting (IK)")
+    parser.add_argument("--keep-height", action="store_true",
+                        help="keep the retargeted height (default: raise or lower the motion "
+                        "so planted feet touch the floor with the body mesh)")  # fmt: skip
     parser.add_argument("--source-map", default="auto", metavar="NAME|FILE.json",
                         help="source bone map: convention name or JSON file")  # fmt: skip
 
@@ -76,15 +81,17 @@ def cli_retarget(args: argparse.Namespace) -> int:
     """``avatar retarget``: every clip onto one rig, a BVH per clip plus a quality line."""
     from avatar.human import Human
 
-    target = Human(rig=args.rig).skeleton
+    human = Human(rig=args.rig)
+    target = human.skeleton
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     table = {}
     for clip in clip_paths(args.clips):
         animation, report = motion_for(target, clip, args)
+        animation, ground = on_floor(human, animation, args)
         bvh.save(out / clip.name, target, animation)
-        print(f"{clip.name}: {report.summary()}")
-        table[str(clip)] = _row(report)
+        print(f"{clip.name}: {report.summary()}\n{ground.summary()}")
+        table[str(clip)] = _row(report) | {"floor": ground.as_dict()}
     if args.report:
         Path(args.report).write_text(json.dumps(table, indent=1) + "\n", encoding="utf-8")
     return 0
@@ -98,11 +105,18 @@ def _row(report: RetargetReport) -> dict:
     return row
 
 
-def report_floor(human, animation: Animation, most_frames: int = 300) -> None:
-    """Log how the skinned body meets the floor over ``animation`` (``floor.measure``)."""
+def on_floor(human, animation: Animation, args: argparse.Namespace, most_frames: int = 3000):
+    """Unless ``--keep-height``: the motion moved up or down as a whole so planted feet
+    touch the floor (``floor.settle``, logged). Returns it and its ``floor.FloorReport``."""
     from avatar.motion import floor
 
-    log.info("%s", floor.measure_human(human, animation, most_frames).summary())
+    if not getattr(args, "keep_height", False):
+        animation, shift = floor.settle_human(human, animation, most_frames)
+        log.info("moved the motion to the floor: %+.1f cm (median; %+.1f to %+.1f cm)",
+                 np.median(shift) * 100, shift.min() * 100, shift.max() * 100)  # fmt: skip
+    report = floor.measure_human(human, animation, most_frames)
+    log.info("%s", report.summary())
+    return animation, report
 
 
 def cli_poses_list(args: argparse.Namespace) -> int:

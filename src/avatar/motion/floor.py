@@ -9,6 +9,7 @@ joint), so this skins the body surface and looks at its lowest point:
 4. hover: while a foot is in contact (its ankle or toe still, ``contacts.detect``) at its
    lowest level over the clip (not on a step), the height of that foot's lowest sole
    vertex above the floor.
+``settle`` moves a motion up or down, frame by frame, so planted feet touch the floor.
 """
 
 from __future__ import annotations
@@ -38,6 +39,9 @@ class FloorReport:
         floor contacts (0 when there are none); hover_max_cm: its maximum.
     contact_frames: measured frames with a foot planted near the floor.
     lowest_cm: (frames,) lowest body vertex per measured frame (cm; negative: below).
+    contact_cm: (frames,) lowest sole vertex of the planted feet per measured frame (cm;
+        NaN where no foot is planted on the floor).
+    sampled: (frames,) the frame indices measured.
     """
 
     frames: int
@@ -48,6 +52,8 @@ class FloorReport:
     hover_max_cm: float
     contact_frames: int
     lowest_cm: np.ndarray
+    contact_cm: np.ndarray
+    sampled: np.ndarray
 
     def summary(self) -> str:
         return (
@@ -58,7 +64,8 @@ class FloorReport:
         )
 
     def as_dict(self) -> dict:
-        return {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "lowest_cm"}
+        arrays = ("lowest_cm", "contact_cm", "sampled")
+        return {k: getattr(self, k) for k in self.__dataclass_fields__ if k not in arrays}
 
 
 def pick_frames(total: int, most: int) -> np.ndarray:
@@ -94,7 +101,8 @@ def measure(
         lowest[start : start + len(pick)] = posed[..., 2].min(axis=1)
         for side, mask in soles.items():
             sole_low[side][start : start + len(pick)] = posed[:, mask, 2].min(axis=1)
-    hover = _hover(skeleton, world, animation.fps, frames, sole_low)
+    heights = _contacts(skeleton, world, animation.fps, frames, sole_low)
+    hover = np.maximum(heights[~np.isnan(heights)], 0.0)
     depth = np.maximum(-lowest, 0.0)
     return FloorReport(
         frames=len(frames),
@@ -105,6 +113,8 @@ def measure(
         hover_max_cm=float(hover.max() * 100) if len(hover) else 0.0,
         contact_frames=len(hover),
         lowest_cm=lowest * 100,
+        contact_cm=heights * 100,
+        sampled=frames,
     )
 
 
@@ -128,23 +138,25 @@ def _soles(skeleton: Skeleton, weights: SkinWeights) -> dict[str, np.ndarray]:
     return out
 
 
-def _hover(skeleton: Skeleton, world: np.ndarray, fps: float, frames: np.ndarray,
-           sole_low: dict[str, np.ndarray]) -> np.ndarray:  # fmt: skip
-    """(n,) heights (m, >= 0) of planted feet's lowest sole vertices over floor contacts."""
+def _contacts(skeleton: Skeleton, world: np.ndarray, fps: float, frames: np.ndarray,
+              sole_low: dict[str, np.ndarray]) -> np.ndarray:  # fmt: skip
+    """(n,) per picked frame, the lowest sole vertex (m) of the feet planted on the floor
+    (NaN: none)."""
     bmap = bonemap.detect(skeleton)
     pos = world[..., :3, 3]
     thigh, foot = bmap.bones.get("thigh.L"), bmap.bones.get("foot.L")
     leg = float(np.linalg.norm(skeleton.heads[thigh] - skeleton.heads[foot])) if (
         thigh is not None and foot is not None) else 0.9  # fmt: skip
     planted = contacts.detect(pos, bmap, fps, leg)
-    out = []
+    out = np.full(len(frames), np.inf)
     for side, low in sole_low.items():
         # The floor is the lowest level the foot gets to; contacts well above it are on
         # steps or boxes. Relative, so a whole character hovering still counts.
         level = np.percentile(low, 5) if len(low) else 0.0
         down = planted.frames(side)[frames] & (low < max(level, 0.0) + _STEP)
-        out.append(np.maximum(low[down], 0.0))
-    return np.concatenate(out) if out else np.zeros(0)
+        out[down] = np.minimum(out[down], low[down])
+    out[np.isinf(out)] = np.nan
+    return out
 
 
 def measure_human(human, animation: Animation, most_frames: int = 300) -> FloorReport:
@@ -152,3 +164,71 @@ def measure_human(human, animation: Animation, most_frames: int = 300) -> FloorR
     index = human.part_vertices("body")
     return measure(human.skeleton, human.vertices[index], human.weights.subset(index),
                    animation, most_frames)  # fmt: skip
+
+
+def settle(
+    skeleton: Skeleton,
+    vertices: np.ndarray,
+    weights: SkinWeights,
+    animation: Animation,
+    most_frames: int = 300,
+    per_frame: bool = True,
+) -> tuple[Animation, np.ndarray]:
+    """The motion moved up or down so that planted feet touch the floor.
+
+    per_frame: each frame with a foot planted on the floor is shifted so that foot's
+    lowest sole vertex is at z = 0; frames between contacts (steps, jumps) blend linearly
+    between the shifts around them, smoothed over 0.1 s, and any frame whose lowest
+    vertex would still be under the floor is lifted onto it. False: one shift for the whole
+    clip (the median of those). Without contacts (a single pose, a clip in the air) the
+    lowest vertex (5th percentile over frames) goes to the floor.
+    Arguments as ``measure``. Returns the moved Animation and the (T,) shifts (metres).
+    """
+    report = measure(skeleton, vertices, weights, animation, most_frames)
+    heights = report.contact_cm / 100
+    down = ~np.isnan(heights)
+    t = animation.frames
+    if not down.any():
+        shift = np.full(t, -float(np.percentile(report.lowest_cm, 5)) / 100)
+    elif not per_frame or down.sum() < 2:
+        shift = np.full(t, -float(np.median(heights[down])))
+    else:
+        shift = np.interp(np.arange(t), report.sampled[down], -heights[down])
+        shift = _smooth(shift, max(1, int(round(0.1 * animation.fps))))
+    if per_frame:
+        # Never below the floor: frames between contacts (heel strike, toe off) lift the
+        # body as far as their lowest vertex needs.
+        lift = np.interp(np.arange(t), report.sampled, -report.lowest_cm / 100)
+        shift = np.maximum(shift, lift)
+    return raise_by(skeleton, animation, shift), shift
+
+
+def _smooth(x: np.ndarray, width: int) -> np.ndarray:
+    """Moving average over ``width`` frames (edges padded with the end values)."""
+    if width < 2 or len(x) < 2:
+        return x
+    pad = np.pad(x, (width // 2, width - 1 - width // 2), mode="edge")
+    return np.convolve(pad, np.ones(width) / width, mode="valid")
+
+
+def raise_by(skeleton: Skeleton, animation: Animation, dz) -> Animation:
+    """The animation with the whole body moved up by ``dz`` metres (scalar or (T,)),
+    through the hips' location."""
+    hips = bonemap.detect(skeleton).bones["hips"]
+    parent = int(skeleton.parents[hips])
+    frame = skeleton.local_rest()[hips, :3, :3]
+    if parent >= 0:
+        world = kinematics.forward(skeleton, animation.rotations, animation.translations)
+        frame = world[:, parent, :3, :3] @ frame
+    up = np.zeros((animation.frames, 3))
+    up[:, 2] = dz
+    translations = animation.translations.copy()
+    translations[:, hips] += np.einsum("...ba,...b->...a", frame, up)
+    return Animation(animation.rotations, translations, animation.fps, animation.bone_names)
+
+
+def settle_human(human, animation: Animation, most_frames: int = 300, per_frame: bool = True):
+    """``settle`` on a Human's skin; returns (animation, (T,) shifts in metres)."""
+    index = human.part_vertices("body")
+    return settle(human.skeleton, human.vertices[index], human.weights.subset(index),
+                  animation, most_frames, per_frame)  # fmt: skip
