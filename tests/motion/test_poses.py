@@ -145,11 +145,13 @@ def test_library_folders_names_and_env(tmp_path, monkeypatch, skeletons):
     raise_arm = {"bone_rotations": {"upperarm01.L": [0.0, 0.0, 0.8]}}
     (tmp_path / "mpfb").mkdir()
     (tmp_path / "mpfb" / "wave.json").write_text(json.dumps(raise_arm))
+    (tmp_path / "mpfb" / "t-pose.json").write_text(json.dumps(raise_arm))  # built-in's name
     (tmp_path / "notes.json").write_text('{"other": 1}')
     names = {e.name: e for e in poselib.list_poses([tmp_path])}
     assert list(names)[:3] == ["rest", "a-pose", "t-pose"]
     assert names["sit01"].source == "bvh" and "Sitting" in names["sit01"].description
     assert names["wave"].source == "mpfb" and "notes" not in names
+    assert names["t-pose"].source == "built-in" and names["mpfb/t-pose"].source == "mpfb"
     monkeypatch.setenv(poselib.ENV_PATH, str(tmp_path))
     assert "sit01" in {e.name for e in poselib.list_poses()}
     skeleton = skeletons["default"]
@@ -157,6 +159,7 @@ def test_library_folders_names_and_env(tmp_path, monkeypatch, skeletons):
     j = skeleton.index("upperarm01.L")
     assert np.count_nonzero(np.abs(wave.rotations[0, :, 0] - 1) > 1e-9) == 1
     assert wave.rotations[0, j, 0] == pytest.approx(np.cos(0.4))
+    np.testing.assert_allclose(poselib.load("mpfb/t-pose", skeleton).rotations, wave.rotations)
     with pytest.raises(ParameterError, match="sit01"):
         poselib.load("sit0", skeleton)
 

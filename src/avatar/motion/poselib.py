@@ -22,7 +22,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -60,13 +60,19 @@ def user_folders(folders: Iterable[str | os.PathLike[str]] = ()) -> list[Path]:
 
 
 def list_poses(folders: Iterable[str | os.PathLike[str]] = ()) -> list[PoseEntry]:
-    """Built-in poses, then every pose file in the user folders (first of a name wins)."""
+    """Built-in poses, then every pose file in the user folders. A file whose name is
+    taken (MPFB's per-rig ``default_fk/t-pose.json``, ``cmu_mb_fk/t-pose.json``) is listed
+    as ``folder/name``; when that is taken too, the first one wins."""
     entries = [PoseEntry(n, "built-in", None, d) for n, d in BUILT_IN.items()]
     seen = set(BUILT_IN)
     for folder in user_folders(folders):
         for path in sorted(folder.rglob("*")) if folder.is_dir() else []:
             entry = _entry(path)
-            if entry is not None and entry.name.lower() not in seen:
+            if entry is None:
+                continue
+            if entry.name.lower() in seen:
+                entry = replace(entry, name=f"{path.parent.name}/{entry.name}")
+            if entry.name.lower() not in seen:
                 seen.add(entry.name.lower())
                 entries.append(entry)
     return entries
