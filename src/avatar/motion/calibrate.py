@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from avatar.motion import geometry
-from avatar.motion.pairs import Pair, segment_rest, segment_world, segments
+from avatar.motion.pairs import Pair, segment_rest, segments
 from avatar.rig import quaternion
 from avatar.rig.kinematics import rest_quaternions
 from avatar.rig.skeleton import Skeleton
@@ -22,41 +22,51 @@ from avatar.rig.skeleton import Skeleton
 _BACK = np.array([0.0, 1.0, 0.0])  # Avatar characters face -Y: knees bend toward +Y
 _UP = np.array([0.0, 0.0, 1.0])
 _MIN_BEND = np.sin(np.radians(15.0))
+STATS_FRAMES = 500  # a median over this many frames is as good as over all, and cheaper
 
 
 class _Side:
-    """Source (T-frame) or target (rest) view of a skeleton: world rotations (quaternions)
-    and heads."""
+    """Source (T frames) or target (rest, one frame) view of a skeleton, bone axis first:
+    world rotations (J, T, 4), heads (J, T, 3) and, for the source, the pairs' segments."""
 
-    def __init__(self, skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray):
-        self.skeleton, self.rot, self.pos = skeleton, rot, pos
+    def __init__(self, skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, segs=None):
+        self.skeleton, self.rot, self.pos, self.segs = skeleton, rot, pos, segs
 
     def seg(self, pair: Pair, source: bool) -> np.ndarray:
+        """(T, 3) the pair's segment on this side."""
+        if source and self.segs is not None:
+            return self.segs[pair.role]
         bone, end = (pair.source, pair.source_end) if source else (pair.target, pair.target_end)
-        return segment_world(self.skeleton, self.rot, self.pos, bone, end)
+        return segments(self.skeleton, self.rot, self.pos, [bone], [end])[0]
 
 
 def offsets(pairs: list[Pair], source: Skeleton, src_rot: np.ndarray, src_pos: np.ndarray,
             target: Skeleton, src_seg: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """(P, 4) alignment quaternion A per pair: target world = source world * A.
 
-    src_rot: (T, Js, 4) source world rotations; src_pos: (T, Js, 3) heads; src_seg:
-    (T, P, 3) the pairs' source segments (``pairs.segments``), computed when None.
+    src_rot: (Js, T, 4) source world rotations; src_pos: (Js, T, 3) heads (bone axis
+    first); src_seg: (P, T, 3) the pairs' source segments (``pairs.segments``), computed
+    when None. The statistics (medians over frames) use at most about ``STATS_FRAMES``
+    frames spread evenly over the clip.
     """
-    src = _Side(source, src_rot, src_pos)
-    tgt = _Side(target, rest_quaternions(target)[0][None], target.heads[None])
-    refs = _references({p.role: p for p in pairs}, src, tgt)
+    every = slice(None, None, -(-src_rot.shape[1] // STATS_FRAMES))
+    src_rot, src_pos = src_rot[:, every], src_pos[:, every]
     if src_seg is None:
         src_seg = segments(source, src_rot, src_pos, [p.source for p in pairs],
                            [p.source_end for p in pairs])  # fmt: skip
+    else:
+        src_seg = src_seg[:, every]
+    src = _Side(source, src_rot, src_pos, {p.role: src_seg[k] for k, p in enumerate(pairs)})
+    tgt = _Side(target, rest_quaternions(target)[0][:, None], target.heads[:, None])
+    refs = _references({p.role: p for p in pairs}, src, tgt)
     out = np.full((len(pairs), 3, 3), np.nan)
     rows = [(k, ref) for k, p in enumerate(pairs)
             if (ref := refs.get(_reference_name(p))) is not None]  # fmt: skip
     if rows:
         ks = [k for k, _ in rows]
         bones = [pairs[k].source for k in ks]
-        world = np.concatenate([src_seg[:, ks], np.stack([r[0] for _, r in rows], 1)], 1)
-        local = _local_median(src_rot[:, bones + bones], world)  # one median for all pairs
+        world = np.concatenate([src_seg[ks], np.stack([r[0] for _, r in rows])])
+        local = _local_median(src_rot[bones + bones], world)  # one median for all pairs
         rt = target.rest[[pairs[k].target for k in ks], :3, :3]
         e_t = np.stack([segment_rest(target, pairs[k].target, pairs[k].target_end) for k in ks])
         s_t = np.einsum("kba,kb->ka", rt, np.stack([r[1] for _, r in rows]))
@@ -105,8 +115,8 @@ def _line(by_role, src: _Side, tgt: _Side, role: str):
     left, right = by_role.get(f"{role}.L"), by_role.get(f"{role}.R")
     if left is None or right is None:
         return None
-    s = src.pos[:, left.source] - src.pos[:, right.source]
-    t = tgt.pos[0, left.target] - tgt.pos[0, right.target]
+    s = src.pos[left.source] - src.pos[right.source]
+    t = tgt.pos[left.target, 0] - tgt.pos[right.target, 0]
     return s, t
 
 
@@ -120,7 +130,7 @@ def _hinge(by_role, src: _Side, tgt: _Side, upper: str, lower: str, bend: np.nda
     bent = np.linalg.norm(cross, axis=-1) > _MIN_BEND
     if bent.sum() < 1:
         return fallback
-    rot = src.rot[:, up.source]
+    rot = src.rot[up.source]
     local = _local_median(rot[bent], cross[bent])
     world_s = quaternion.rotate(rot, local)
     world_t = geometry.unit(np.cross(tgt.seg(up, False)[0], bend))
@@ -128,10 +138,10 @@ def _hinge(by_role, src: _Side, tgt: _Side, upper: str, lower: str, bend: np.nda
 
 
 def _local_median(rot: np.ndarray, world: np.ndarray) -> np.ndarray:
-    """(..., 3) median over frames of world vectors (T, ..., 3) seen in bone frames
-    (T, ..., 4)."""
-    local = geometry.unit(quaternion.rotate(quaternion.conjugate(rot), world))
-    return geometry.unit(np.median(local, axis=0))
+    """(..., 3) median over frames of world vectors (..., T, 3) seen in bone frames
+    (..., T, 4)."""
+    local = geometry.unit(quaternion.rotate(rot, world, inverse=True))
+    return geometry.unit(np.median(local, axis=-2))
 
 
 def _choose(out: np.ndarray, pairs: list[Pair], source: Skeleton, target: Skeleton):

@@ -86,8 +86,8 @@ def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray
           root: np.ndarray, fps: float) -> np.ndarray:  # fmt: skip
     """Bend the target's legs so pinned joints stay put.
 
-    world: (T, J, 4) target world rotations (NaN: not evaluated); root: (T, 3) hips heads.
-    Returns new world rotations.
+    world: (J, T, 4) target world rotations, bone axis first (NaN: not evaluated);
+    root: (T, 3) hips heads. Returns new world rotations.
     """
     world = world.copy()
     hips = tmap.bones["hips"]
@@ -106,25 +106,25 @@ def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray
 
 
 def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: float):
-    """(T, 3) where the ankle should be (NaN: leave it), blended around contacts."""
+    """(T, 3) where the ankle should be, blended around contacts; pos (J, T, 3)."""
     ankle = tmap.bones[f"foot.{side}"]
-    offset = np.zeros((len(pos), 3))
-    weight = np.zeros(len(pos))
+    offset = np.zeros((len(pinned), 3))
+    weight = np.zeros(len(pinned))
     for role in ("foot", "toe"):
         j = tmap.bones.get(f"{role}.{side}")
         if j is None:
             continue
         rest_z = target.heads[j, 2]
         for a, b in _runs(pinned == role):
-            pin = pos[a:b, j].mean(axis=0)
+            pin = pos[j, a:b].mean(axis=0)
             if pin[2] - rest_z < _NEAR_FLOOR * _leg(target, tmap, side):
                 pin[2] = rest_z  # a floor contact: exactly on the floor
-            offset[a:b] = pin - pos[a:b, j]
+            offset[a:b] = pin - pos[j, a:b]
             weight[a:b] = 1.0
     if not weight.any():
         return None
     offset, weight = _blend(offset, weight, max(1, int(round(_BLEND_S * fps))))
-    return pos[:, ankle] + offset * weight[:, None]
+    return pos[ankle] + offset * weight[:, None]
 
 
 def _blend(offset: np.ndarray, weight: np.ndarray, n: int):
@@ -145,13 +145,14 @@ def _leg(target: Skeleton, tmap: BoneMap, side: str) -> float:
 
 
 def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int, goal) -> None:
-    """Rotate thigh and shin chains (in place) so the ankle reaches ``goal`` (T, 3)."""
-    h, k, a = pos[:, thigh], pos[:, shin], pos[:, foot]
+    """Rotate thigh and shin chains (in place) so the ankle reaches ``goal`` (T, 3);
+    world (J, T, 4), pos (J, T, 3)."""
+    h, k, a = pos[thigh], pos[shin], pos[foot]
     l1 = np.linalg.norm(k - h, axis=-1)
     l2 = np.linalg.norm(a - k, axis=-1)
     hinge = np.cross(a - k, h - k)
     weak = np.linalg.norm(hinge, axis=-1) < 1e-6 * l1 * l2
-    x_axis = quaternion.rotate(world[:, thigh], np.array([1.0, 0.0, 0.0]))
+    x_axis = quaternion.rotate(world[thigh], np.array([1.0, 0.0, 0.0]))
     hinge = np.where(weak[:, None], x_axis, hinge)  # straight leg: bone X
     hinge = geometry.unit(hinge)
     reach = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
@@ -162,5 +163,5 @@ def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int,
     turn = quaternion.between(a_new - h, goal - h)
     upper = geometry.path(target, thigh, shin)[:-1]
     lower = geometry.path(target, shin, foot)[:-1]
-    world[:, upper] = quaternion.multiply(turn[:, None], world[:, upper])
-    world[:, lower] = quaternion.multiply(quaternion.multiply(turn, bend)[:, None], world[:, lower])
+    world[upper] = quaternion.multiply(turn, world[upper])
+    world[lower] = quaternion.multiply(quaternion.multiply(turn, bend), world[lower])

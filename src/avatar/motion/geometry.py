@@ -15,7 +15,7 @@ from avatar.rig.skeleton import Skeleton
 
 def unit(v: np.ndarray) -> np.ndarray:
     """(..., 3) vectors scaled to length 1 (zero vectors stay zero)."""
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    n = np.sqrt(np.einsum("...i,...i->...", v, v))[..., None]  # einsum: no temporaries
     return v / np.maximum(n, 1e-12)
 
 
@@ -69,7 +69,7 @@ def offsets(skeleton: Skeleton) -> np.ndarray:
 
 def positions(skeleton: Skeleton, world: np.ndarray, roots: dict[int, np.ndarray],
               bones: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
-    """(T, J, 3) bone heads from world bone rotations (T, J, 4) quaternions.
+    """(J, T, 3) bone heads from world bone rotations (J, T, 4) (bone axis first).
 
     roots: bone index -> (T, 3) head positions of bones placed directly (translated bones);
     other parentless bones stay at their rest heads.
@@ -81,12 +81,12 @@ def positions(skeleton: Skeleton, world: np.ndarray, roots: dict[int, np.ndarray
     for group in levels(parents, bones):
         p = parents[group]
         if p[0] < 0:
-            out[:, group] = skeleton.heads[group]
+            out[group] = skeleton.heads[group, None]
         else:
-            out[:, group] = out[:, p] + quaternion.rotate(world[:, p], off[group])
+            out[group] = out[p] + quaternion.rotate(world[p], off[group, None])
         for j in group:
             if int(j) in roots:
-                out[:, j] = roots[int(j)]
+                out[j] = roots[int(j)]
     return out
 
 

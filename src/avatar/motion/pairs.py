@@ -81,26 +81,32 @@ def make_pairs(
 
 
 def segments(skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, bones, ends) -> np.ndarray:
-    """(T, n, 3) world segment vectors of ``bones`` (n,) ending at ``ends`` (n,) (encoded as
+    """(n, T, 3) world segment vectors of ``bones`` (n,) ending at ``ends`` (n,) (encoded as
     ``Pair.target_end``: a bone's head, -1 its own tail, -2 - b the tail of bone b).
 
-    rot: (T, J, 4) world bone rotations (quaternions); pos: (T, J, 3) world heads.
+    rot: (J, T, 4) world bone rotations (quaternions); pos: (J, T, 3) world heads (bone
+    axis first, as the retargeter keeps them).
     """
     bones, ends = np.asarray(bones, dtype=int), np.asarray(ends, dtype=int)
     other = np.where(ends == -1, bones, -2 - ends)
-    out = pos[:, np.where(ends >= 0, ends, other)] - pos[:, bones]
+    out = pos[np.where(ends >= 0, ends, other)] - pos[bones]
     tail = np.flatnonzero(ends < 0)
     if len(tail):
         o = other[tail]
         local = np.einsum("jba,jb->ja", skeleton.rest[o, :3, :3],
                           skeleton.tails[o] - skeleton.heads[o])  # fmt: skip
-        out[:, tail] += quaternion.rotate(rot[:, o], local)
+        out[tail] += quaternion.rotate(rot[o], local[:, None])
     return out
 
 
 def segment_world(skeleton: Skeleton, rot: np.ndarray, pos: np.ndarray, bone: int, end: int):
-    """(T, 3) world segment vector of one bone (see ``segments``)."""
-    return segments(skeleton, rot, pos, [bone], [end])[:, 0]
+    """(T, 3) world segment vector of one bone; rot (T, J, 4) and pos (T, J, 3) frame
+    first (see ``segments``)."""
+    if end >= 0:
+        return pos[:, end] - pos[:, bone]
+    other = bone if end == -1 else -2 - end
+    local = skeleton.rest[other, :3, :3].T @ (skeleton.tails[other] - skeleton.heads[other])
+    return pos[:, other] - pos[:, bone] + quaternion.rotate(rot[:, other], local)
 
 
 def segment_rest(skeleton: Skeleton, bone: int, end: int) -> np.ndarray:

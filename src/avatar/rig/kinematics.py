@@ -30,42 +30,66 @@ def levels(parents: np.ndarray, which: np.ndarray | None = None) -> list[np.ndar
 def rest_quaternions(skeleton: Skeleton) -> tuple[np.ndarray, np.ndarray]:
     """(J, 4) rest rotations and (J, 4) rotations relative to the parent's rest frame."""
     rest = quaternion.from_matrix(skeleton.rest[:, :3, :3])
-    return rest, quaternion.from_matrix(skeleton.local_rest()[:, :3, :3])
+    return rest, _local_rest(skeleton, rest)[0]
+
+
+def _local_rest(skeleton: Skeleton, rest: np.ndarray | None = None):
+    """(J, 4) rest rotations relative to the parent's and (J, 3) heads in the parent's
+    rest frame (rigid rest frames: the inverse is the conjugate, no LAPACK call)."""
+    if rest is None:
+        rest = quaternion.from_matrix(skeleton.rest[:, :3, :3])
+    parents = skeleton.parents
+    has = parents >= 0
+    local = rest.copy()
+    step = skeleton.heads.copy()
+    inverse = quaternion.conjugate(rest[parents[has]])
+    local[has] = quaternion.multiply(inverse, rest[has])
+    step[has] = quaternion.rotate(inverse, skeleton.heads[has] - skeleton.heads[parents[has]])
+    return local, step
 
 
 def world_pose(
-    skeleton: Skeleton, rotations: np.ndarray, translations: np.ndarray | None = None
+    skeleton: Skeleton,
+    rotations: np.ndarray,
+    translations: np.ndarray | None = None,
+    *,
+    bones_first: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """World bone rotations and heads for a pose (Blender's pose-bone evaluation).
 
-    rotations: (..., J, 4) quaternions in each bone's rest frame (normalised here).
+    rotations: (..., J, 4) unit quaternions in each bone's rest frame.
     translations: (..., J, 3) pose locations in each bone's rest frame, or None.
+    bones_first: return the bone axis first, (J, ..., 4) and (J, ..., 3): the layout in
+        which per-bone gathers over many frames are contiguous (what motion work wants).
     Returns (..., J, 4) world rotations (bone frame -> world) and (..., J, 3) heads (metres).
     """
-    local_rest = skeleton.local_rest()
-    step_rest = local_rest[:, :3, 3]  # head in the parent's frame
-    turn_rest = quaternion.from_matrix(local_rest[:, :3, :3])
-    rotations = rotations / np.linalg.norm(rotations, axis=-1, keepdims=True)
-    local = quaternion.multiply(turn_rest, rotations)
-    step = np.broadcast_to(step_rest, rotations.shape[:-1] + (3,))
+    rest_rot, rest_step = _local_rest(skeleton)
+    count = len(skeleton.names)
+    batch = rotations.shape[:-2]
+    rot_in = np.moveaxis(rotations, -2, 0).reshape(count, -1, 4)  # (J, F, 4), F frames
+    local = rot_in @ quaternion.left_matrix(rest_rot)  # rest * rotation, per bone
+    step = np.broadcast_to(rest_step[:, None], rot_in.shape[:-1] + (3,))
     if translations is not None:
-        moved = np.flatnonzero(np.any(translations != 0, axis=tuple(range(translations.ndim - 2))
-                                      + (-1,)))  # fmt: skip
-        if len(moved):
+        trans = np.moveaxis(translations, -2, 0).reshape(count, -1, 3)
+        moved = [j for j in range(count) if np.any(trans[j])]
+        if moved:
             step = step.copy()
-            step[..., moved, :] += quaternion.rotate(turn_rest[moved], translations[..., moved, :])
-    rot = np.empty(rotations.shape)
-    pos = np.empty(rotations.shape[:-1] + (3,))
+            step[moved] += quaternion.rotate(rest_rot[moved, None], trans[moved])
+    rot = np.empty(local.shape)
+    pos = np.empty(step.shape)
     parents = skeleton.parents
     for group in levels(parents):
         p = parents[group]
         if p[0] < 0:  # roots (depth 0)
-            rot[..., group, :], pos[..., group, :] = local[..., group, :], step[..., group, :]
-            continue
-        parent_rot = rot[..., p, :]
-        rot[..., group, :] = quaternion.multiply(parent_rot, local[..., group, :])
-        pos[..., group, :] = pos[..., p, :] + quaternion.rotate(parent_rot, step[..., group, :])
-    return rot, pos
+            rot[group], pos[group] = local[group], step[group]
+        else:
+            parent_rot = rot[p]
+            rot[group] = quaternion.multiply(parent_rot, local[group])
+            pos[group] = pos[p] + quaternion.rotate(parent_rot, step[group])
+    rot, pos = rot.reshape((count,) + batch + (4,)), pos.reshape((count,) + batch + (3,))
+    if bones_first:
+        return rot, pos
+    return np.moveaxis(rot, 0, -2), np.moveaxis(pos, 0, -2)
 
 
 def pose_matrices(rotations: np.ndarray, translations: np.ndarray | None = None) -> np.ndarray:

@@ -19,16 +19,49 @@ def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Vectors v (..., 3) turned by unit quaternions q (..., 4) (broadcast) -> (..., 3)."""
+def right_matrix(b: np.ndarray) -> np.ndarray:
+    """(..., 4) -> (..., 4, 4) M with a * b == a @ M for any row quaternions a.
+
+    Multiplying many quaternions by one (a bone's fixed rest or alignment rotation) is then
+    one matrix product, several times faster than the component formula.
+    """
+    w, x, y, z = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    rows = [(w, x, y, z), (-x, w, -z, y), (-y, z, w, -x), (-z, -y, x, w)]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def left_matrix(a: np.ndarray) -> np.ndarray:
+    """(..., 4) -> (..., 4, 4) M with a * b == b @ M for any row quaternions b."""
+    w, x, y, z = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    rows = [(w, x, y, z), (-x, w, z, -y), (-y, -z, w, x), (-z, y, -x, w)]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False) -> np.ndarray:
+    """Vectors v (..., 3) turned by unit quaternions q (..., 4) (broadcast) -> (..., 3);
+    ``inverse``: turned by the conjugates instead."""
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
-    # v' = v + w t + u x t with t = 2 u x v (u = the vector part): 15 products, no matrix.
-    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    # v' = v + w t + u x t with t = 2 u x v (u = the vector part); the inverse negates w.
+    tx = y * vz
+    tx -= z * vy
+    tx *= 2.0
+    ty = z * vx
+    ty -= x * vz
+    ty *= 2.0
+    tz = x * vy
+    tz -= y * vx
+    tz *= 2.0
     out = np.empty(np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,))
-    out[..., 0] = vx + w * tx + y * tz - z * ty
-    out[..., 1] = vy + w * ty + z * tx - x * tz
-    out[..., 2] = vz + w * tz + x * ty - y * tx
+    for k, (t, a, b, c, d) in enumerate(((tx, vx, y, tz, z * ty), (ty, vy, z, tx, x * tz),
+                                         (tz, vz, x, ty, y * tx))):  # fmt: skip
+        o = w * t
+        if inverse:
+            o = np.negative(o, out=o)
+        o += a
+        o += b * c
+        o -= d
+        out[..., k] = o
     return out
 
 
@@ -39,16 +72,19 @@ def between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     vector gives the identity.
     """
     a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
-    na, nb = np.linalg.norm(a, axis=-1), np.linalg.norm(b, axis=-1)
-    ab = na * nb
+    ax, ay, az, bx, by, bz = a[..., 0], a[..., 1], a[..., 2], b[..., 0], b[..., 1], b[..., 2]
+    na = np.sqrt(ax * ax + ay * ay + az * az)
+    ab = na * np.sqrt(bx * bx + by * by + bz * bz)
     q = np.empty(a.shape[:-1] + (4,))
-    q[..., 0] = ab + np.sum(a * b, -1)  # |a||b| (1 + cos): the half-angle form, no trig
-    q[..., 1:] = np.cross(a, b)
-    n = np.linalg.norm(q, axis=-1)
+    q[..., 0] = ab + ax * bx + ay * by + az * bz  # |a||b| (1 + cos): half-angle form, no trig
+    q[..., 1] = ay * bz - az * by
+    q[..., 2] = az * bx - ax * bz
+    q[..., 3] = ax * by - ay * bx
+    n = np.sqrt(np.einsum("...i,...i->...", q, q))
     q /= np.where(n > 0, n, 1.0)[..., None]
     opposite = n <= 1e-9 * ab
     if np.any(opposite) or np.any(ab == 0):
-        other = np.where((np.abs(a[..., 0]) < 0.9 * na)[..., None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        other = np.where((np.abs(ax) < 0.9 * na)[..., None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
         axis = np.cross(a, other)
         axis /= np.maximum(np.linalg.norm(axis, axis=-1, keepdims=True), 1e-300)
         flip = np.concatenate([np.zeros(a.shape[:-1] + (1,)), axis], -1)
