@@ -133,6 +133,13 @@ def _cap(body: AuthoringBody) -> Piece:
     return join([crown, hair.brim(body, crown)])
 
 
+EYELASH_GROUPS = (
+    "helper-l-eyelashes-1",
+    "helper-l-eyelashes-2",
+    "helper-r-eyelashes-1",
+    "helper-r-eyelashes-2",
+)
+
 SPECS = [
     Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02)), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.97), sleeve_ease(0.006, 0.012)), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
@@ -156,12 +163,6 @@ SPECS = [
     Spec("eyelashes", "face", lambda b: face.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
 ]  # fmt: skip
 
-EYELASH_GROUPS = (
-    "helper-l-eyelashes-1",
-    "helper-l-eyelashes-2",
-    "helper-r-eyelashes-1",
-    "helper-r-eyelashes-2",
-)
 BY_NAME = {s.name: s for s in SPECS}
 
 

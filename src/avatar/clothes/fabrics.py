@@ -40,7 +40,7 @@ FABRICS = {
     "canvas": Fabric("canvas", "plain", 70, 1.8, 0.9, 0.2),
     "lycra": Fabric("lycra", "knit", 160, 0.6, 0.35, 0.06),
     "wool": Fabric("wool", "twill", 60, 2.2, 0.95, 0.25),
-    "hair": Fabric("hair", "strands", 220, 2.5, 0.4, 0.6),
+    "hair": Fabric("hair", "strands", 220, 2.5, 0.5, 0.6),
 }
 
 COLOURS = {

@@ -102,8 +102,12 @@ def hairline_mask(body: AuthoringBody, lift: float = 0.0) -> np.ndarray:
     c = body.vertices[body.skin_faces].mean(axis=1)
     line = eye_z + lift + np.interp(around(c, centre), HAIRLINE_DEG, HAIRLINE_M)
     ear = (np.abs(c[:, 0]) > 0.066) & (c[:, 2] < eye_z + 0.033)
-    near = np.hypot(c[:, 0], c[:, 1] - centre[1]) < 0.11
-    return near & (c[:, 2] > line) & ~ear
+    radial = (c - centre)[:, :2]
+    near = np.linalg.norm(radial, axis=1) < 0.11
+    # The mouth and throat are skin too: keep only faces that look away from the head's axis.
+    normal = body.skin_normals[body.skin_faces].mean(axis=1)[:, :2]
+    outside = (np.einsum("fd,fd->f", normal, radial) > 0) | (c[:, 2] > eye_z + 0.06)
+    return near & outside & (c[:, 2] > line) & ~ear
 
 
 def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:

@@ -184,4 +184,6 @@ def hair_material(spec, size: int = 1024) -> Material:
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
     rgb = np.asarray(fabrics.COLOURS[spec.colour])[None, None, :] * shade[..., None]
     colour = np.concatenate([fabrics.srgb(rgb), alpha[..., None]], -1)
-    return replace(m, base_color_texture=colour, alpha_mode=mode)
+    # Hair is a fibre, not a mirror: a weaker specular keeps dark hair from glaring white.
+    extras = {**m.extras, "specular": 0.3}
+    return replace(m, base_color_texture=colour, alpha_mode=mode, extras=extras)
