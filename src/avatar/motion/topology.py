@@ -9,6 +9,7 @@ Steps (``infer``):
 3. each limb is cut into segments by the anatomical proportions of a human (thigh : shin :
    foot : toe and clavicle : upper arm : forearm : hand), measured as lengths along the
    chain, which no pose changes; joints at one place take the role from the first of them;
+   fingers are the chains below the hand (the thumb starts nearest the wrist);
 4. left and right: the character's left is ``up x facing``, facing being where the toes
    point (Avatar's -Y when a skeleton has no toes).
 
@@ -89,9 +90,9 @@ def infer(skeleton: Skeleton, heads: np.ndarray | None = None) -> dict[str, int]
     heads: (J, 3) or (T, J, 3) world heads of poses to read heights and sides from when
         the rest pose is not an upright human (Reallusion's folded offsets); an upright
         rest is always preferred, being the most neutral pose there is.
-    Returns {canonical role: joint index} for the roles found among ``bonemap.CORE``
-    (hips, spine, chest, neck, head, and clavicle..hand, thigh..toe per side);
-    {} when the skeleton has no two legs.
+    Returns {canonical role: joint index} for the roles found: ``bonemap.CORE`` (hips,
+    spine, chest, neck, head, and clavicle..hand, thigh..toe per side) and fingers
+    (thumb1..pinky3); {} when the skeleton has no two legs.
     """
     tree = _tree(skeleton)
     roles = _roles(tree, skeleton.heads[None])
@@ -138,7 +139,45 @@ def _roles(tree: _Tree, pose: np.ndarray) -> dict[str, int]:
         arms.reverse()
     for side, arm in zip("LR", arms, strict=True):
         roles.update({f"{k}.{side}": v for k, v in arm.items()})
+        if "hand" in arm:
+            roles.update({f"{k}.{side}": v for k, v in _fingers(tree, pose, arm["hand"]).items()})
     return roles
+
+
+def _fingers(tree: _Tree, pose: np.ndarray, hand: int) -> dict[str, int]:
+    """thumb1..pinky3 below a hand: each finger is a chain to a fingertip; its last three
+    joints are the phalanges (metacarpals before them are left out). The thumb's base sits
+    apart from the row of knuckles (with two fingers only: the shorter one); the others
+    are named by their distance from the thumb across the palm (index, middle, ring,
+    pinky; a finger alone is the middle one)."""
+    chains: dict[int, list[int]] = {}
+    for tip in tree.leaves(below=hand):
+        path = tree.path(hand, tip)
+        if path:
+            joints = _points(tree, path)[0][-3:]
+            chains.setdefault(joints[0], joints)
+    reach = {f: tree.dist[c[-1]] - tree.dist[hand] + tree.tips[c[-1]] for f, c in chains.items()}
+    chains = {f: c for f, c in chains.items() if reach[f] > 0.3 * max(reach.values())}
+    if not chains:
+        return {}
+    apart = {f: np.mean([np.linalg.norm(pose[:, f] - pose[:, g], axis=-1).mean()
+                         for g in chains if g != f] or [0.0]) for f in chains}  # fmt: skip
+    names = {}
+    if len(chains) == 1:
+        names[next(iter(chains))] = "middle"
+    else:
+        thumb = (
+            max(chains, key=lambda f: apart[f]) if len(chains) > 2 else min(chains, key=reach.get)
+        )
+        names[thumb] = "thumb"
+        gap = {
+            f: float(np.linalg.norm(pose[:, f] - pose[:, thumb], axis=-1).mean()) for f in chains
+        }
+        others = sorted((f for f in chains if f != thumb), key=gap.get)
+        order = ("middle",) if len(others) == 1 else ("index", "middle", "ring", "pinky")
+        names.update(zip(others, order, strict=False))
+    return {f"{names[f]}{i}": j for f, c in chains.items() if f in names
+            for i, j in enumerate(c, 1)}  # fmt: skip
 
 
 def _same_side(pose: np.ndarray, legs: list[dict[str, int]], arms: list[dict[str, int]]) -> float:
