@@ -167,13 +167,15 @@ def _fingers(tree: _Tree, pose: np.ndarray, hand: int) -> dict[str, int]:
         names[next(iter(chains))] = "middle"
     else:
         thumb = (
-            max(chains, key=lambda f: apart[f]) if len(chains) > 2 else min(chains, key=reach.get)
+            max(chains, key=lambda f: apart[f])
+            if len(chains) > 2
+            else min(chains, key=lambda f: reach[f])
         )
         names[thumb] = "thumb"
         gap = {
             f: float(np.linalg.norm(pose[:, f] - pose[:, thumb], axis=-1).mean()) for f in chains
         }
-        others = sorted((f for f in chains if f != thumb), key=gap.get)
+        others = sorted((f for f in chains if f != thumb), key=lambda f: gap[f])
         order = ("middle",) if len(others) == 1 else ("index", "middle", "ring", "pinky")
         names.update(zip(others, order, strict=False))
     return {f"{names[f]}{i}": j for f, c in chains.items() if f in names
