@@ -86,10 +86,9 @@ def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray
           root: np.ndarray, fps: float) -> np.ndarray:  # fmt: skip
     """Bend the target's legs so pinned joints stay put.
 
-    world: (J, T, 4) target world rotations, bone axis first (NaN: not evaluated);
-    root: (T, 3) hips heads. Returns new world rotations.
+    world: (J, T, 4) target world rotations, bone axis first (bones not evaluated: NaN in
+    frame 0), changed in place and returned; root: (T, 3) hips heads.
     """
-    world = world.copy()
     hips = tmap.bones["hips"]
     legs = [tmap.bones[f"{r}.{s}"] for r in ("thigh", "shin", "foot", "toe") for s in "LR"
             if f"{r}.{s}" in tmap.bones]  # fmt: skip

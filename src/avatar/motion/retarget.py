@@ -127,8 +127,10 @@ def retarget(
 
 def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.ndarray,
               target: Skeleton) -> np.ndarray:  # fmt: skip
-    """(Jt, T, 4) target world bone rotations (quaternions; NaN: not evaluated)."""
-    world = np.full((len(target.names), src.rot.shape[1], 4), np.nan)
+    """(Jt, T, 4) target world bone rotations (quaternions). Rows of bones not evaluated
+    are left undefined (no memory touched) and marked NaN in frame 0."""
+    world = np.empty((len(target.names), src.rot.shape[1], 4))
+    world[:, 0, 0] = np.nan
     # source world * A, as one matrix product per pair (A is fixed)
     world[[p.target for p in pairs]] = src.rot[[p.source for p in pairs]] @ right_matrix(align)
     # Bones that only follow their parent keep an identity pose rotation whatever happens
