@@ -103,6 +103,8 @@ def test_avatar_rigs_by_topology_match_names(model):
         named = bonemap.detect(skeleton).bones
     found = topology.infer(skeleton)
     assert {r: found.get(r) for r in named} == named, rig
+    forced = bonemap.detect(skeleton, "topology")  # also by name, e.g. --source-map
+    assert forced.convention == "topology" and forced.bones == found
 
 
 @needs_fixtures
