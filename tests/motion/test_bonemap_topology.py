@@ -168,3 +168,14 @@ def test_renamed_clip_retargets_the_same(clip):
     assert err.max() < 1.0
     hips = [forward(target, a.rotations, a.translations)[:, 0, :3, 3] for a in (ref, out)]
     assert np.abs(hips[0] - hips[1]).max() < 0.01
+
+
+@needs_fixtures
+@pytest.mark.parametrize("clip", CLIPS, ids=lambda p: p.name)
+def test_renamed_file_loads_with_the_same_axes_and_unit(clip):
+    """Up axis and unit detection fall back on the hierarchy when names say nothing."""
+    data = bvh.read(clip)
+    anon = replace(data, names=tuple(f"j{j}" for j in range(len(data.names))))
+    up = bvh.detect_up(data)
+    assert bvh.detect_up(anon) == up
+    assert bvh.detect_unit(anon, up) == bvh.detect_unit(data, up)

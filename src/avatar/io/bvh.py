@@ -478,11 +478,18 @@ def _named(data: BvhData, words: tuple[str, ...], avoid: tuple[str, ...] = ()) -
 
 
 def _head_and_feet(data: BvhData) -> tuple[int, list[int]] | None:
+    """The head joint and the feet: by name, else from the hierarchy (``topology``)."""
     heads = _named(data, ("head",), ("fore", "end", "top"))
     feet = _named(data, ("foot", "footl", "footr", "ankle", "anklel", "ankler"))
-    if not heads or len(feet) < 2:
+    if heads and len(feet) >= 2:
+        return heads[0], feet
+    from avatar.motion import topology  # lazy: motion imports this module
+
+    poses = world_positions(data, _sample(data, 16)) if data.frames else None
+    roles = topology.upright_roles(data.parents, data.offsets, poses)
+    if roles is None:
         return None
-    return heads[0], feet
+    return roles["head"], [roles["foot.L"], roles["foot.R"]]
 
 
 def _rest_positions(data: BvhData) -> np.ndarray:
@@ -510,9 +517,9 @@ def _path_length(data: BvhData, a: int, b: int) -> float:
 
 
 def detect_up(data: BvhData) -> str:
-    """The file's up axis as the signed axis closest to feet -> head over the clip; without
-    recognisable head/foot names, the axis the figure spans most, signed so that most
-    joints sit above the root."""
+    """The file's up axis as the signed axis closest to feet -> head over the clip (head
+    and feet by name, else from the hierarchy); failing both, the axis the figure spans
+    most, signed so that most joints sit above the root."""
     found = _head_and_feet(data)
     if found is not None:
         head, feet = found

@@ -68,8 +68,10 @@ class _Tree:
 
 
 def _tree(skeleton: Skeleton) -> _Tree:
-    parents = skeleton.parents
-    heads = skeleton.heads
+    return _tree_of(skeleton.parents, skeleton.heads, skeleton.lengths)
+
+
+def _tree_of(parents: np.ndarray, heads: np.ndarray, tips: np.ndarray) -> _Tree:
     children: list[list[int]] = [[] for _ in parents]
     dist = np.zeros(len(parents))
     ancestors: list[list[int]] = []
@@ -80,7 +82,42 @@ def _tree(skeleton: Skeleton) -> _Tree:
             ancestors.append([j, *ancestors[p]])
         else:
             ancestors.append([j])
-    return _Tree(parents, children, dist, ancestors, skeleton.lengths)
+    return _Tree(parents, children, dist, ancestors, tips)
+
+
+def upright_roles(
+    parents: np.ndarray, offsets: np.ndarray, poses: np.ndarray | None = None
+) -> dict[str, int] | None:
+    """Bone roles of a humanoid in any axes, for files whose joint names mean nothing
+    (``io.bvh`` finds the up axis and the unit from the head and feet).
+
+    parents: (J,); offsets: (J, 3) rest offsets from each parent (any unit, any axes);
+    poses: (T, J, 3) joint positions of some frames in the same axes, or None.
+    Each signed axis is tried as up, on the rest pose and on the poses; the roles are those
+    of the reading in which feet, hips, chest and head rise by the widest margin. None
+    when no reading finds two legs, two arms and a head.
+    """
+    heads = np.asarray(offsets, dtype=float).copy()
+    for j, p in enumerate(parents):
+        if p >= 0:
+            heads[j] += heads[p]
+    tree = _tree_of(np.asarray(parents), heads, np.zeros(len(parents)))
+    views = [heads[None]] if poses is None else [heads[None], np.asarray(poses, dtype=float)]
+    best, out = 0.0, None
+    for view in views:
+        for axis in range(3):
+            others = [a for a in range(3) if a != axis]
+            for sign in (1.0, -1.0):
+                turned = view[..., [*others, axis]] * [1.0, 1.0, sign]
+                roles = _roles(tree, turned)
+                chain = [roles.get(r) for r in ("head", "chest", "hips", "foot.L", "foot.R")]
+                if None in chain:
+                    continue
+                z = np.median(turned[:, chain, 2], axis=0)
+                margin = min(z[0] - z[1], z[1] - z[2], z[2] - max(z[3], z[4]))
+                if margin > best:
+                    best, out = margin, roles
+    return out
 
 
 def infer(skeleton: Skeleton, heads: np.ndarray | None = None) -> dict[str, int]:
