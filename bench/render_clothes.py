@@ -15,13 +15,13 @@ from pathlib import Path
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-blender-"))
 
 BODIES = [
-    ({"gender": 0.0, "age": 0.5, "weight": 0.5}, ("eyebrows", "eyelashes", "hair-long", "tshirt", "jeans", "shoes")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.5, "weight": 0.5}, ("eyebrows-blond", "eyelashes", "hair-long", "tshirt", "jeans", "shoes")),  # noqa: E501
     ({"gender": 1.0, "age": 0.6, "weight": 0.9, "muscle": 0.3}, ("eyebrows", "eyelashes", "hair-short", "longsleeve", "trousers", "socks", "shoes")),  # noqa: E501
-    ({"gender": 0.0, "age": 0.3, "weight": 0.2}, ("eyebrows", "eyelashes", "hair-ponytail", "dress", "shoes")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.3, "weight": 0.2}, ("eyebrows-black", "eyelashes", "hair-ponytail", "dress", "shoes")),  # noqa: E501
     ({"gender": 1.0, "age": 0.9, "weight": 0.6}, ("eyebrows", "eyelashes", "cap", "jacket", "tshirt", "shorts", "socks", "shoes")),  # noqa: E501
     ({"gender": 0.0, "age": 0.45, "weight": 0.7}, ("eyebrows", "eyelashes", "hair-short", "tanktop", "skirt", "shoes")),  # noqa: E501
     ({"gender": 1.0, "age": 0.25, "muscle": 1.0}, ("eyebrows", "eyelashes", "hair-short", "hoodie", "leggings", "shoes")),  # noqa: E501
-    ({"gender": 0.0, "age": 0.5, "weight": 0.4}, ("eyebrows", "eyelashes", "hair-long", "swimsuit")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.5, "weight": 0.4}, ("eyebrows-blond", "eyelashes", "hair-long", "swimsuit")),  # noqa: E501
 ]  # fmt: skip
 
 

@@ -42,7 +42,21 @@ def material(record: object | None, fallback_name: str = "Material") -> bpy.type
     _link_normal(mat.node_tree, bsdf, record)
     if record.alpha_mode == "BLEND" and hasattr(mat, "surface_render_method"):
         mat.surface_render_method = "BLENDED"  # EEVEE; Cycles blends regardless
+    if record.alpha_mode != "OPAQUE":
+        allow_transparent_layers(bpy.context.scene)
     return mat
+
+
+def allow_transparent_layers(scene: bpy.types.Scene, layers: int = 64) -> None:
+    """Let Cycles see through ``layers`` stacked cut-outs (hair cards, lashes).
+
+    Cycles stops at ``transparent_max_bounces`` (8 by default) and shades what is left
+    black, so the tips of long hair, where many cards overlap, would render black. Only
+    raises the limit.
+    """
+    cycles = getattr(scene, "cycles", None)
+    if cycles is not None and cycles.transparent_max_bounces < layers:
+        cycles.transparent_max_bounces = layers
 
 
 def plain(name: str, colour: Sequence[float], roughness: float = 0.6) -> bpy.types.Material:

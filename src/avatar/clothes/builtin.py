@@ -160,6 +160,8 @@ SPECS = [
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 500, (0.1, 0.16), 0.02, (0.004, 0.012), 6), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 500, (0.08, 0.14), 0.02, (0.003, 0.008), 6), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
     Spec("eyebrows", "face", face.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
+    Spec("eyebrows-blond", "face", face.eyebrows, "hair", "blond hair", 0.0, 5, ("eyebrows", "blond"), False),  # noqa: E501
+    Spec("eyebrows-black", "face", face.eyebrows, "hair", "black hair", 0.0, 5, ("eyebrows", "black"), False),  # noqa: E501
     Spec("eyelashes", "face", lambda b: face.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
 ]  # fmt: skip
 

@@ -1,7 +1,14 @@
-"""Head pieces grown from the skin: hair caps, hair cards, a cap's brim, eyebrows.
+"""Hair grown from the skin, and a cap's crown and brim.
 
-Hair textures share one layout: v in [0.5, 1] is dense (caps), v in [0, 0.5] is strand cards
-from root (v = 0.5) to tip (v = 0), their alpha thinning towards the tips.
+A hairstyle is a dense ``base_cap`` over the scalp inside a hairline (so no skin shows
+between strands) plus strand cards: ``grow_cards`` roots cards inside the hairline and lays
+them along a flow field (radiating from the crown, combed from a parting, drawn back to a
+tie) at a lift above the scalp that grows towards the top of the head, which gives the
+volume and silhouette of a haircut; ``long_cards`` hangs cards between the guide curves of
+MakeHuman's ``helper-hair`` ribbons; ``ponytail`` gathers cards around a falling spine.
+
+Hair textures share one layout (``textures``): v in [0.5, 1] is dense strands (caps),
+v in [0, 0.5] strand cards from root (v = 0.5) to tip (v = 0), alpha thinning at the tips.
 """
 
 from __future__ import annotations

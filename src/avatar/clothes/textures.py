@@ -175,7 +175,7 @@ def hair_material(spec, size: int = 1024) -> Material:
     rather than cut out, so they read as soft fringes instead of dotted cards. Hair cards
     cut out (``MASK``), which real-time engines draw without sorting.
     """
-    if spec.name == "eyebrows":
+    if spec.name.startswith("eyebrows"):
         alpha, mode, shade = brow_alpha(size), "BLEND", np.ones((size, size), np.float32)
     elif spec.name == "eyelashes":
         alpha, mode, shade = lash_alpha(size), "BLEND", np.ones((size, size), np.float32)
