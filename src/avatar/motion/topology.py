@@ -110,10 +110,10 @@ def upright_roles(
             for sign in (1.0, -1.0):
                 turned = view[..., [*others, axis]] * [1.0, 1.0, sign]
                 roles = _roles(tree, turned)
-                chain = [roles.get(r) for r in ("head", "chest", "hips", "foot.L", "foot.R")]
-                if None in chain:
+                names = ("head", "chest", "hips", "foot.L", "foot.R")
+                if not all(r in roles for r in names):
                     continue
-                z = np.median(turned[:, chain, 2], axis=0)
+                z = np.median(turned[:, [roles[r] for r in names], 2], axis=0)
                 margin = min(z[0] - z[1], z[1] - z[2], z[2] - max(z[3], z[4]))
                 if margin > best:
                     best, out = margin, roles
