@@ -179,3 +179,23 @@ def test_renamed_file_loads_with_the_same_axes_and_unit(clip):
     up = bvh.detect_up(data)
     assert bvh.detect_up(anon) == up
     assert bvh.detect_unit(anon, up) == bvh.detect_unit(data, up)
+
+
+@needs_fixtures
+def test_anonymous_file_end_to_end(tmp_path):
+    """A BVH file whose joints are j0..jN: loaded upright at the right size, mapped by
+    topology and retargeted as the named file (< 1 degree), with the report saying so."""
+    from avatar.human import Human
+
+    clip = FIXTURES / "cmu_3dsmax" / "131_01_start_walk_stop.bvh"
+    data = bvh.read(clip)
+    bvh.write(
+        tmp_path / "anon.bvh", replace(data, names=tuple(f"j{j}" for j in range(len(data.names))))
+    )
+    target = Human().skeleton
+    frames = slice(0, 120)
+    ref, _ = retarget(*bvh.load(clip), target, frames=frames, match_names=False)
+    out, report = retarget(*bvh.load(tmp_path / "anon.bvh"), target, frames=frames)
+    assert report.source_convention == "topology" and "j1" in report.unused_source
+    err = geometry.angle(_core_directions(target, ref), _core_directions(target, out))
+    assert err.max() < 1.0
