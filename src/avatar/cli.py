@@ -230,13 +230,7 @@ def _animation(human, args: argparse.Namespace):
     if args.pose:
         from pathlib import Path
 
-        from avatar.motion.cli import on_floor
-        from avatar.motion.poselib import BUILT_IN
-
-        pose = human.pose(args.pose, args.pose_folder)
-        if args.pose.lower() not in BUILT_IN:  # a pose file: stand it on the floor
-            pose, _ = on_floor(human, pose, args)
-        return pose, Path(args.pose).stem
+        return human.pose(args.pose, args.pose_folder), Path(args.pose).stem  # on the floor
     return None, None
 
 

@@ -137,13 +137,15 @@ class Human:
     def pose(self, name: str, folders: Sequence[str] = ()) -> Animation:
         """A pose for this rig (1 frame): "rest", "a-pose", "t-pose" (any rig, from its
         geometry), a pose of the library (``folders``, ``$AVATAR_POSES_PATH``), or a
-        ``.bvh``/MPFB ``.json`` pose file; see ``avatar.motion.poselib``."""
-        from avatar.motion import poselib
+        ``.bvh``/MPFB ``.json`` pose file; all but "rest" stood on the floor (lowest skin
+        vertex at z = 0, ``motion.floor.settle``). See ``avatar.motion.poselib``."""
+        from avatar.motion import floor, poselib
 
         def reference() -> Skeleton:  # MPFB pose files name the MakeHuman default rig's bones
             return Human(self.params, "default", self.model).skeleton
 
-        return poselib.load(name, self.skeleton, folders, reference)
+        pose = poselib.load(name, self.skeleton, folders, reference)
+        return pose if name.lower() == "rest" else floor.settle_human(self, pose)[0]
 
     def posed(
         self, animation: Animation, frames: slice | None = None, method: str = "lbs"

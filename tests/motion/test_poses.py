@@ -74,6 +74,13 @@ def test_human_pose_names(skeletons, model):
     np.testing.assert_allclose(_arm_drop(human.skeleton, human.pose("t-pose")), 0.0, atol=0.5)
     with pytest.raises(ParameterError, match="t-pose"):
         human.pose("t-pos")
+    from avatar.motion import floor
+
+    lowest = floor.measure_human(human, human.pose("a-pose")).lowest_cm
+    assert abs(lowest[0]) < 0.05  # stood on the floor
+    if MH_POSES.is_dir():  # a sitting pose file: feet on the floor, nothing under it
+        sit = floor.measure_human(human, human.pose(str(MH_POSES / "sit01.bvh")))
+        assert abs(sit.lowest_cm[0]) < 0.05
 
 
 def test_rebase_keeps_the_world_motion_and_inverse_undoes_it(skeletons):
