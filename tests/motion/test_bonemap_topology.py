@@ -199,3 +199,25 @@ def test_anonymous_file_end_to_end(tmp_path):
     assert report.source_convention == "topology" and "j1" in report.unused_source
     err = geometry.angle(_core_directions(target, ref), _core_directions(target, out))
     assert err.max() < 1.0
+
+
+def test_random_trees_never_break_it():
+    """Any hierarchy (random trees, random poses) gives roles on real joints or nothing,
+    and ``detect`` either maps hips or says it cannot: no other exception."""
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        count = int(rng.integers(1, 40))
+        parents = np.array([-1] + [int(rng.integers(0, j)) for j in range(1, count)], np.int32)
+        heads = np.cumsum(rng.normal(size=(count, 3)) * 0.2, axis=0)
+        rest = np.tile(np.eye(4), (count, 1, 1))
+        rest[:, :3, 3] = heads
+        skeleton = Skeleton(tuple(f"x{j}" for j in range(count)), parents, rest,
+                            heads + rng.normal(size=(count, 3)) * 0.05)  # fmt: skip
+        roles = topology.infer(skeleton, rng.normal(size=(5, count, 3)))
+        assert all(0 <= j < count for j in roles.values())
+        assert set(roles) <= set(bonemap.NEXT)
+        topology.upright_roles(parents, rng.normal(size=(count, 3)), rng.normal(size=(3, count, 3)))
+        try:
+            assert "hips" in bonemap.detect(skeleton).bones
+        except ParameterError:
+            pass

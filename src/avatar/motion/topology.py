@@ -9,12 +9,14 @@ Steps (``infer``):
 3. each limb is cut into segments by the anatomical proportions of a human (thigh : shin :
    foot : toe and clavicle : upper arm : forearm : hand), measured as lengths along the
    chain, which no pose changes; joints at one place take the role from the first of them;
-   fingers are the chains below the hand (the thumb starts nearest the wrist);
+   fingers are the chains below the hand (the thumb's base sits apart from the knuckles);
 4. left and right: the character's left is ``up x facing``, facing being where the toes
    point (Avatar's -Y when a skeleton has no toes).
 
 Only lengths along the tree and a few signs are read from the poses, so any rest (T, A,
-arms down, or Reallusion's folded offsets) works when ``heads`` are posed frames.
+arms down, or Reallusion's folded offsets) works when ``heads`` are posed frames; an
+upright rest is read first. ``upright_roles`` also finds the up axis of a file in unknown
+axes (the BVH reader's fallback when names say nothing).
 """
 
 from __future__ import annotations
@@ -193,10 +195,10 @@ def _fingers(tree: _Tree, pose: np.ndarray, hand: int) -> dict[str, int]:
         if path:
             joints = _points(tree, path)[0][-3:]
             chains.setdefault(joints[0], joints)
-    reach = {f: tree.dist[c[-1]] - tree.dist[hand] + tree.tips[c[-1]] for f, c in chains.items()}
-    chains = {f: c for f, c in chains.items() if reach[f] > 0.3 * max(reach.values())}
     if not chains:
         return {}
+    reach = {f: tree.dist[c[-1]] - tree.dist[hand] + tree.tips[c[-1]] for f, c in chains.items()}
+    chains = {f: c for f, c in chains.items() if reach[f] > 0.3 * max(reach.values())}
     apart = {f: np.mean([np.linalg.norm(pose[:, f] - pose[:, g], axis=-1).mean()
                          for g in chains if g != f] or [0.0]) for f in chains}  # fmt: skip
     names = {}
