@@ -216,3 +216,18 @@ def test_cli_clip_named_and_floor_reported(tmp_path, model, caplog):
         assert cli.main(["create", "--motion", str(WALK), "--frames", "0:40", "-o", str(out)]) == 0
     assert list(gltf.read(out).animations) == [WALK.stem]
     assert "mesh on floor: penetration" in caplog.text
+
+
+def test_glb_animation_named_by_save(tmp_path, model):
+    from avatar.export import save
+    from avatar.human import Human
+    from avatar.io import gltf
+
+    human = Human(model=model)
+    pose = human.pose("t-pose")
+    save(human, tmp_path / "a.glb", pose, animation_name="jump")
+    assert list(gltf.read(tmp_path / "a.glb").animations) == ["jump"]
+    save(human, tmp_path / "b.glb", pose)
+    assert list(gltf.read(tmp_path / "b.glb").animations) == ["animation"]
+    save(human, tmp_path / "c.glb")
+    assert gltf.read(tmp_path / "c.glb").animations == {}
