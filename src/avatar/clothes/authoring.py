@@ -78,13 +78,24 @@ def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease, relax: i
     used, inverse = np.unique(chosen, return_inverse=True)
     points = body.vertices[used]
     local = inverse.reshape(chosen.shape).astype(np.int32)
+    normals = surface_normals(body, faces)[used]
     if relax:
-        points = relax_boundary(points, local, body.outward(points), relax)
+        points = relax_boundary(points, local, normals, relax)
     if callable(ease):
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
-    points = points + np.asarray(ease)[..., None] * body.outward(points)
+    points = points + np.asarray(ease)[..., None] * normals
     return with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+
+
+def surface_normals(body: AuthoringBody, faces: np.ndarray) -> np.ndarray:
+    """(V, 3) unit vertex normals of a source surface (base-mesh faces), turned to face away
+    from the body. Easing along the surface's own normal keeps a loose surface smooth: the
+    skin's normal would push neighbours of a skirt between the legs towards opposite legs."""
+    normals = vertex_normals(body.vertices.astype(np.float32), faces).astype(np.float64)
+    used = np.unique(faces)
+    agree = np.einsum("nd,nd->n", normals[used], body.outward(body.vertices[used]))
+    return normals if agree.sum() >= 0 else -normals
 
 
 def relax_boundary(

@@ -63,7 +63,9 @@ def top(sleeve: float, neck: float = 0.0, hem: float = 0.04):
     """Torso above the hip line (+hem), sleeves to ``sleeve`` along the arm."""
 
     def keep(ff, m):
-        torso = (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + hem) & (_z(ff) < m.neck[2] - neck)
+        # Upper-thigh faces too, so a long top's hem runs level instead of following the groin.
+        trunk = (ff.part == "torso") | (ff.part == "leg")
+        torso = trunk & (_z(ff) > m.hip[0, 2] + hem) & (_z(ff) < m.neck[2] - neck)
         return torso | ((ff.part == "arm") & (ff.arm < sleeve))
 
     return keep
