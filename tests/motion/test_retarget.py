@@ -144,18 +144,8 @@ def test_a_different_rest_pose_with_baked_motion_gives_the_same_result(target, r
     _compare(target, reference[0], out, 1.0)
 
 
-KNOWN_MISS = {  # open: see docs/benchmarks.md "Motion"
-    "01_14_climb_jumpdown.bvh": "chest segment p95 6 deg: CMU neck starts at the chest head",
-}
-
-
 @needs_fixtures
-@pytest.mark.parametrize(
-    "clip",
-    [pytest.param(c, marks=pytest.mark.xfail(reason=KNOWN_MISS[c.name], strict=False))
-     if c.name in KNOWN_MISS else c for c in CLIPS],
-    ids=lambda p: f"{p.parent.name}/{p.name}",
-)  # fmt: skip
+@pytest.mark.parametrize("clip", CLIPS, ids=lambda p: f"{p.parent.name}/{p.name}")
 def test_quality_targets_on_every_fixture_clip(target, clip):
     sk, an = bvh.load(clip)
     _, report = retarget(sk, an, target)

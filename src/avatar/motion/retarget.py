@@ -187,22 +187,33 @@ def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton
         if len(chain) >= 2:
             want = src.pos[b.source] - src.pos[a.source]
             out.append(_Aim(chain[:-1], off[chain[1:]], want))
-    limbs = sorted(range(len(pairs)), key=lambda k: pairs[k].target)
+    limbs = [k for k in sorted(range(len(pairs)), key=lambda k: pairs[k].target)
+             if pairs[k].kind != "trunk" and not pairs[k].role.startswith("=")]  # fmt: skip
+    aimed = {pairs[k].target for k in limbs}  # same-named extras keep their twist
     for k in limbs:
         p = pairs[k]
-        if p.kind == "trunk" or p.role.startswith("="):  # same-named extras keep their twist
+        if p.target_end >= -1:  # up to the end bone's head, or along the bone itself
+            path = (
+                [p.target] if p.target_end == -1 else geometry.path(target, p.target, p.target_end)
+            )
+        else:  # the tail of a bone starting at this one's joint on one skeleton
+            path = geometry.path(target, p.target, -2 - p.target_end)
+        # A segment that runs over the next aimed bone (which starts at this one's joint on
+        # one skeleton: CMU's finger base at the wrist) is aimed only up to that bone's
+        # head, the same way; that bone follows its own pair (on the source both run along
+        # one line), so both parts, and so the whole segment, follow the source.
+        if not path:
             continue
-        if p.target_end == -1:
-            bones, vectors = [p.target], segment_rest(target, p.target, -1)[None]
-        elif p.target_end < -1:  # the tail of a bone starting at this one's head
-            other = -2 - p.target_end
-            bones = geometry.path(target, p.target, other)
-            tail = segment_rest(target, other, -1)
-            vectors = np.concatenate([off[bones[1:]], tail[None]]) if bones else tail[None]
+        cut = next((i for i, j in enumerate(path[1:], 1) if j in aimed), None)
+        if cut is not None:
+            bones, vectors = path[:cut], off[path[1 : cut + 1]]
+        elif p.target_end == -1 or p.target_end < -1:
+            bones = path
+            tail = segment_rest(target, path[-1], -1)[None]
+            vectors = np.concatenate([off[path[1:]], tail])
         else:
-            bones = geometry.path(target, p.target, p.target_end)[:-1]
-            vectors = off[bones[1:] + [p.target_end]]
-        if bones:
+            bones, vectors = path[:-1], off[path[1:]]
+        if bones and np.linalg.norm(vectors.sum(axis=0)) > 1e-6:
             out.append(_Aim(bones, vectors, src_seg[k]))
     return out
 
