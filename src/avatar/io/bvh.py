@@ -313,15 +313,22 @@ def dumps(data: BvhData, precision: int = 6) -> str:
     for j, p in enumerate(data.parents):
         if p >= 0:
             children[p].append(j)
+    order: list[int] = []  # joints in the order the hierarchy lists them (depth first)
     for root in np.flatnonzero(data.parents < 0):
-        _write_joint(out, data, children, int(root), 0, precision)
+        _write_joint(out, data, children, int(root), 0, precision, order)
     out.write(f"MOTION\nFrames: {data.frames}\nFrame Time: {data.frame_time:.8g}\n")
     if data.motion.size:
-        np.savetxt(out, data.motion, fmt=f"%.{precision}f", delimiter=" ")
+        # Columns follow the hierarchy's order, which differs from the joints' own order
+        # when a parent's later children come after other joints (Avatar's rigs).
+        starts = data.channel_starts()
+        cols = [starts[j] + k for j in order for k in range(len(data.channels[j]))]
+        np.savetxt(out, data.motion[:, cols], fmt=f"%.{precision}f", delimiter=" ")
     return out.getvalue()
 
 
-def _write_joint(out, data: BvhData, children, j: int, depth: int, precision: int) -> None:
+def _write_joint(out, data: BvhData, children, j: int, depth: int, precision: int,
+                 order: list[int]) -> None:  # fmt: skip
+    order.append(j)
     pad, fmt = "\t" * depth, f"%.{precision}f"
     kind = "ROOT" if data.parents[j] < 0 else "JOINT"
     offset = " ".join(fmt % v for v in data.offsets[j])
@@ -329,7 +336,7 @@ def _write_joint(out, data: BvhData, children, j: int, depth: int, precision: in
     out.write(f"{pad}{kind} {data.names[j]}\n{pad}{{\n{pad}\tOFFSET {offset}\n")
     out.write(f"{pad}\tCHANNELS {len(chans)}{''.join(' ' + c for c in chans)}\n")
     for c in children[j]:
-        _write_joint(out, data, children, c, depth + 1, precision)
+        _write_joint(out, data, children, c, depth + 1, precision, order)
     if not np.isnan(data.end_sites[j, 0]):
         end = " ".join(fmt % v for v in data.end_sites[j])
         out.write(f"{pad}\tEnd Site\n{pad}\t{{\n{pad}\t\tOFFSET {end}\n{pad}\t}}\n")
