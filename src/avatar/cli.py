@@ -193,7 +193,8 @@ def run_create(args: argparse.Namespace) -> int:
         human = Human(solved, human.recipe.rig, model, human.recipe)
     human = _dress(human, args.wear)
     animation, name = _animation(human, args)
-    path = save(human, args.output, animation, args.expressions, args.hide_covered, name)
+    path = save(human, args.output, animation, args.expressions, args.hide_covered, name,
+                args.rest)  # fmt: skip
     log.info("wrote %s", path)
     if args.render:
         from avatar.blender.picture import render_human

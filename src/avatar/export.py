@@ -37,6 +37,18 @@ def _gltf(human: Human, path: Path, animation: Animation | None, options: dict) 
     gltf.write(path, human.parts(**options), human.skeleton, clips)
 
 
+def _bvh(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
+    from avatar.io import bvh
+    from avatar.motion import poselib
+    from avatar.rig.poses import rest_pose
+
+    skeleton = human.skeleton
+    motion = animation if animation is not None else rest_pose(skeleton)
+    if options.get("rest"):  # e.g. a T-pose rest for pipelines that expect one
+        skeleton, motion = poselib.switch_rest(skeleton, motion, options["rest"])
+    bvh.save(path, skeleton, motion)
+
+
 def _blender(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.blender import export, scene
 
@@ -48,6 +60,7 @@ def _blender(human: Human, path: Path, animation: Animation | None, options: dic
 WRITERS: dict[str, Callable[[Human, Path, Animation | None, dict], None]] = {
     ".mhm": _mhm,
     ".obj": _obj,
+    ".bvh": _bvh,
     ".glb": _gltf,
     ".gltf": _gltf,
     ".fbx": _blender,
@@ -65,6 +78,7 @@ def save(
     expressions: bool = False,
     hide_covered: bool = False,
     animation_name: str | None = None,
+    rest: str | None = None,
 ) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
@@ -72,8 +86,11 @@ def save(
     hide_covered: leave out skin that garments cover entirely (glTF; default: keep it).
     animation_name: the glTF animation's name, e.g. the clip's file stem (default
         "animation"); players and Blender's importer show it as the clip/action name.
+    rest: BVH only: write the skeleton resting in this pose ("t-pose", "a-pose", a pose
+        file) with the motion re-expressed on it (``poselib.switch_rest``).
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
-    (the skin mesh), .mhm (MakeHuman character file), .fbx/.usd/.blend (through Blender).
+    (the skin mesh), .mhm (MakeHuman character file), .bvh (the skeleton and its motion,
+    or its rest pose), .fbx/.usd/.blend (through Blender).
     """
     path = Path(path)
     writer = WRITERS.get(path.suffix.lower())
@@ -82,5 +99,7 @@ def save(
     path.parent.mkdir(parents=True, exist_ok=True)
     options = {"expressions": expressions, "hide_covered": hide_covered,
                "animation_name": animation_name}  # fmt: skip
+    if rest:
+        options["rest"] = rest
     writer(human, path, animation, options)
     return path

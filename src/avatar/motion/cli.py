@@ -31,6 +31,9 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fps", type=float, help="output frame rate (default: the clip's)")
     parser.add_argument("--in-place", action="store_true", help="remove horizontal root motion")
     parser.add_argument("--no-foot-fix", action="store_true", help="skip contact planting (IK)")
+    parser.add_argument("--rest", metavar="POSE",
+                        help="BVH output: rest the skeleton in this pose (t-pose, a-pose, a "
+                        "pose file), the motion re-expressed on it")  # fmt: skip
     parser.add_argument("--keep-height", action="store_true",
                         help="keep the retargeted height (default: raise or lower the motion "
                         "so planted feet touch the floor with the body mesh)")  # fmt: skip
@@ -89,7 +92,12 @@ def cli_retarget(args: argparse.Namespace) -> int:
     for clip in clip_paths(args.clips):
         animation, report = motion_for(target, clip, args)
         animation, ground = on_floor(human, animation, args)
-        bvh.save(out / clip.name, target, animation)
+        skeleton = target
+        if args.rest:
+            from avatar.motion import poselib
+
+            skeleton, animation = poselib.switch_rest(target, animation, args.rest)
+        bvh.save(out / clip.name, skeleton, animation)
         print(f"{clip.name}: {report.summary()}\n{ground.summary()}")
         table[str(clip)] = _row(report) | {"floor": ground.as_dict()}
     if args.report:
