@@ -103,7 +103,7 @@ def retarget(
     src_seg = segments(source_skeleton, src.rot, src.pos, [p.source for p in pairs],
                        [p.source_end for p in pairs])  # fmt: skip
     align = calibrate.offsets(pairs, source_skeleton, src.rot, src.pos, target_skeleton, src_seg)
-    world = _transfer(pairs, align, src, src_seg, target_skeleton)
+    world, rigid = _transfer(pairs, align, src, src_seg, target_skeleton)
     scale = _leg_length(target_skeleton, tmap) / _leg_length(source_skeleton, smap)
     hips = tmap.bones["hips"]
     root = _root_path(src, smap, tmap, target_skeleton, scale, in_place)
@@ -113,7 +113,7 @@ def retarget(
         feet = contacts.detect(src.pos.swapaxes(0, 1), smap, anim.fps, leg)
     if feet is not None and fix_feet:
         world = contacts.plant(feet, tmap, target_skeleton, world, root, anim.fps)
-    out = _to_local(target_skeleton, world, hips, root, anim.fps)
+    out = _to_local(target_skeleton, world, rigid, hips, root, anim.fps)
     quality = None
     if measure:
         ends = [p.target for p in pairs] + [_far(p) for p in pairs]
@@ -126,8 +126,9 @@ def retarget(
 
 
 def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.ndarray,
-              target: Skeleton) -> np.ndarray:  # fmt: skip
-    """(Jt, T, 4) target world bone rotations (quaternions). Rows of bones not evaluated
+              target: Skeleton) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(Jt, T, 4) target world bone rotations (quaternions) and (Jt,) bool, the evaluated
+    bones that keep their rest pose relative to their parent. Rows of bones not evaluated
     are left undefined (no memory touched) and marked NaN in frame 0."""
     world = np.empty((len(target.names), src.rot.shape[1], 4))
     world[:, 0, 0] = np.nan
@@ -140,9 +141,9 @@ def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.nd
     rest, local = rest_quaternions(target)
     _inherit(world, target, local, free & needed)
     free &= ~_share_chains(world, pairs, target, rest)
-    _aim(world, _aims(pairs, src, src_seg, target))
+    _aim(world, _aims(pairs, src, src_seg, target, free & needed, local))
     _inherit(world, target, local, free & needed)  # side branches follow the turned bones
-    return world
+    return world, free & needed
 
 
 def _far(p: Pair) -> int:
@@ -171,7 +172,8 @@ class _Aim:
     want: np.ndarray
 
 
-def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton) -> list[_Aim]:
+def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton,
+          rigid: np.ndarray, local: np.ndarray) -> list[_Aim]:  # fmt: skip
     """Segment aims in the order they apply: trunk chains (start bone and in-between bones,
     far end along the source's start-to-end line; exact, the far end depends only on the
     chain's own rotations), then limb segments (a bone and any bones up to the segment's
@@ -186,7 +188,7 @@ def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton
         chain = geometry.path(target, a.target, b.target)
         if len(chain) >= 2:
             want = src.pos[b.source] - src.pos[a.source]
-            out.append(_Aim(chain[:-1], off[chain[1:]], want))
+            out.append(_rigid_folded(_Aim(chain[:-1], off[chain[1:]], want), rigid, local))
     limbs = [k for k in sorted(range(len(pairs)), key=lambda k: pairs[k].target)
              if pairs[k].kind != "trunk" and not pairs[k].role.startswith("=")]  # fmt: skip
     aimed = {pairs[k].target for k in limbs}  # same-named extras keep their twist
@@ -214,8 +216,24 @@ def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton
         else:
             bones, vectors = path[:-1], off[path[1:]]
         if bones and np.linalg.norm(vectors.sum(axis=0)) > 1e-6:
-            out.append(_Aim(bones, vectors, src_seg[k]))
+            out.append(_rigid_folded(_Aim(bones, vectors, src_seg[k]), rigid, local))
     return out
+
+
+def _rigid_folded(aim: _Aim, rigid: np.ndarray, local: np.ndarray) -> _Aim:
+    """The same aim over fewer bones: a bone that keeps its rest pose relative to its parent
+    (``rigid``; re-derived from the parent after the aims) adds its vector, turned by its
+    rest rotation ``local`` (J, 4), to its parent's."""
+    bones, vectors, carry = [], [], np.zeros(3)
+    for j, v in zip(aim.bones[::-1], aim.vectors[::-1], strict=True):
+        carry = carry + v
+        if rigid[j] and j != aim.bones[0]:
+            carry = quaternion.rotate(local[j], carry)
+        else:
+            bones.append(j)
+            vectors.append(carry)
+            carry = np.zeros(3)
+    return _Aim(bones[::-1], np.array(vectors[::-1]), aim.want)
 
 
 def _aim(world: np.ndarray, aims: list[_Aim]) -> None:
@@ -296,15 +314,17 @@ def _root_path(src: _Source, smap, tmap, target: Skeleton, scale: float, in_plac
     return out
 
 
-def _to_local(target: Skeleton, world: np.ndarray, hips: int, root: np.ndarray, fps: float):
+def _to_local(target: Skeleton, world: np.ndarray, rigid: np.ndarray, hips: int,
+              root: np.ndarray, fps: float):  # fmt: skip
     """World rotations (J, T, 4) and hips heads (T, 3) -> Blender pose-bone values.
 
-    Bones left unevaluated (NaN: they only follow their parent) get the identity.
+    Bones left unevaluated (NaN: they only follow their parent) and ``rigid`` ones (J,)
+    (evaluated, but in their rest pose relative to the parent) get the identity.
     """
     j, t = world.shape[:2]
     posed = ~np.isnan(world[:, 0, 0])
     parents = target.parents
-    free = ~posed | ((parents >= 0) & ~posed[np.maximum(parents, 0)])
+    free = ~posed | rigid | ((parents >= 0) & ~posed[np.maximum(parents, 0)])
     bones = np.flatnonzero(~free)
     rest, local_rest = rest_quaternions(target)
     p = parents[bones]
