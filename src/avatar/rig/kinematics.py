@@ -68,24 +68,28 @@ def world_pose(
     batch = rotations.shape[:-2]
     rot_in = np.moveaxis(rotations, -2, 0).reshape(count, -1, 4)  # (J, F, 4), F frames
     local = rot_in @ quaternion.left_matrix(rest_rot)  # rest * rotation, per bone
-    step = np.broadcast_to(rest_step[:, None], rot_in.shape[:-1] + (3,))
+    moved: dict[int, np.ndarray] = {}  # bone -> (F, 3) head in the parent's frame
     if translations is not None:
         trans = np.moveaxis(translations, -2, 0).reshape(count, -1, 3)
-        moved = [j for j in range(count) if np.any(trans[j])]
-        if moved:
-            step = step.copy()
-            step[moved] += quaternion.rotate(rest_rot[moved, None], trans[moved])
+        for j in range(count):
+            if np.any(trans[j]):
+                moved[j] = rest_step[j] + quaternion.rotate(rest_rot[j], trans[j])
     rot = np.empty(local.shape)
-    pos = np.empty(step.shape)
+    pos = np.empty(local.shape[:-1] + (3,))
     parents = skeleton.parents
     for group in levels(parents):
+        step = rest_step[group, None]  # (n, 1, 3): the same every frame unless translated
+        if any(int(j) in moved for j in group):
+            step = np.repeat(step, local.shape[1], axis=1)
+            for i, j in enumerate(group):
+                step[i] = moved.get(int(j), step[i])
         p = parents[group]
         if p[0] < 0:  # roots (depth 0)
-            rot[group], pos[group] = local[group], step[group]
+            rot[group], pos[group] = local[group], step
         else:
             parent_rot = rot[p]
             rot[group] = quaternion.multiply(parent_rot, local[group])
-            pos[group] = pos[p] + quaternion.rotate(parent_rot, step[group])
+            pos[group] = pos[p] + quaternion.rotate(parent_rot, step)
     rot, pos = rot.reshape((count,) + batch + (4,)), pos.reshape((count,) + batch + (3,))
     if bones_first:
         return rot, pos
