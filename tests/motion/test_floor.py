@@ -78,6 +78,10 @@ def test_settle_puts_planted_feet_on_the_floor(human):
     np.testing.assert_allclose(shift, -bob, atol=0.003)
     report = floor.measure_human(human, settled)
     assert report.penetration_cm < 0.1 and report.hover_cm < 0.1
+    # The report after a shift follows from the one before, without skinning again.
+    guess = floor.measure_human(human, lifted).shifted(shift)
+    np.testing.assert_allclose(guess.lowest_cm, report.lowest_cm, atol=1e-3)
+    assert guess.hover_cm == pytest.approx(report.hover_cm, abs=1e-3)
     _, one = floor.settle_human(human, lifted, per_frame=False)
     np.testing.assert_allclose(one, -np.median(bob), atol=0.003)
     sunk, up = floor.settle_human(human, _shifted(human, [-0.05]))  # one frame: no contacts

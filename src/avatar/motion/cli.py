@@ -118,11 +118,12 @@ def on_floor(human, animation: Animation, args: argparse.Namespace, most_frames:
     touch the floor (``floor.settle``, logged). Returns it and its ``floor.FloorReport``."""
     from avatar.motion import floor
 
+    report = floor.measure_human(human, animation, most_frames)
     if not getattr(args, "keep_height", False):
-        animation, shift = floor.settle_human(human, animation, most_frames)
+        animation, shift = floor.settle_human(human, animation, most_frames, report=report)
+        report = report.shifted(shift)
         log.info("moved the motion to the floor: %+.1f cm (median; %+.1f to %+.1f cm)",
                  np.median(shift) * 100, shift.min() * 100, shift.max() * 100)  # fmt: skip
-    report = floor.measure_human(human, animation, most_frames)
     log.info("%s", report.summary())
     return animation, report
 

@@ -67,6 +67,32 @@ class FloorReport:
         arrays = ("lowest_cm", "contact_cm", "sampled")
         return {k: getattr(self, k) for k in self.__dataclass_fields__ if k not in arrays}
 
+    @classmethod
+    def of(cls, total: int, sampled: np.ndarray, lowest_m: np.ndarray, contact_m: np.ndarray):
+        """The report from per-frame lowest vertex and planted sole heights (metres)."""
+        hover = np.maximum(contact_m[~np.isnan(contact_m)], 0.0)
+        depth = np.maximum(-lowest_m, 0.0)
+        return cls(
+            frames=len(sampled),
+            total_frames=total,
+            penetration_cm=float(depth.max(initial=0.0) * 100),
+            penetrating=float(np.mean(depth > _TOLERANCE)) if len(sampled) else 0.0,
+            hover_cm=float(np.median(hover) * 100) if len(hover) else 0.0,
+            hover_max_cm=float(hover.max() * 100) if len(hover) else 0.0,
+            contact_frames=len(hover),
+            lowest_cm=lowest_m * 100,
+            contact_cm=contact_m * 100,
+            sampled=sampled,
+        )
+
+    def shifted(self, shift: np.ndarray) -> FloorReport:
+        """The report after moving the body up by ``shift`` (T,) metres per frame (what
+        ``settle`` does), without skinning again: heights move by the shift; the contact
+        frames are kept."""
+        dz = np.asarray(shift, dtype=float)[self.sampled]
+        return FloorReport.of(self.total_frames, self.sampled, self.lowest_cm / 100 + dz,
+                              self.contact_cm / 100 + dz)  # fmt: skip
+
 
 def pick_frames(total: int, most: int) -> np.ndarray:
     """(n,) frame indices: all when ``total <= most``, else ``most`` evenly spaced."""
@@ -102,20 +128,7 @@ def measure(
         for side, mask in soles.items():
             sole_low[side][start : start + len(pick)] = posed[:, mask, 2].min(axis=1)
     heights = _contacts(skeleton, world, animation.fps, frames, sole_low)
-    hover = np.maximum(heights[~np.isnan(heights)], 0.0)
-    depth = np.maximum(-lowest, 0.0)
-    return FloorReport(
-        frames=len(frames),
-        total_frames=animation.frames,
-        penetration_cm=float(depth.max(initial=0.0) * 100),
-        penetrating=float(np.mean(depth > _TOLERANCE)) if len(frames) else 0.0,
-        hover_cm=float(np.median(hover) * 100) if len(hover) else 0.0,
-        hover_max_cm=float(hover.max() * 100) if len(hover) else 0.0,
-        contact_frames=len(hover),
-        lowest_cm=lowest * 100,
-        contact_cm=heights * 100,
-        sampled=frames,
-    )
+    return FloorReport.of(animation.frames, frames, lowest, heights)
 
 
 def _soles(skeleton: Skeleton, weights: SkinWeights) -> dict[str, np.ndarray]:
@@ -173,6 +186,7 @@ def settle(
     animation: Animation,
     most_frames: int = 300,
     per_frame: bool = True,
+    report: FloorReport | None = None,
 ) -> tuple[Animation, np.ndarray]:
     """The motion moved up or down so that planted feet touch the floor.
 
@@ -182,9 +196,11 @@ def settle(
     vertex would still be under the floor is lifted onto it. False: one shift for the whole
     clip (the median of those). Without contacts (a single pose, a clip in the air) the
     lowest vertex (5th percentile over frames) goes to the floor.
-    Arguments as ``measure``. Returns the moved Animation and the (T,) shifts (metres).
+    Arguments as ``measure``; ``report``: its result when already at hand. Returns the
+    moved Animation and the (T,) shifts (metres); ``report.shifted(shifts)`` tells how it
+    meets the floor now.
     """
-    report = measure(skeleton, vertices, weights, animation, most_frames)
+    report = report or measure(skeleton, vertices, weights, animation, most_frames)
     heights = report.contact_cm / 100
     down = ~np.isnan(heights)
     t = animation.frames
@@ -227,8 +243,9 @@ def raise_by(skeleton: Skeleton, animation: Animation, dz) -> Animation:
     return Animation(animation.rotations, translations, animation.fps, animation.bone_names)
 
 
-def settle_human(human, animation: Animation, most_frames: int = 300, per_frame: bool = True):
+def settle_human(human, animation: Animation, most_frames: int = 300, per_frame: bool = True,
+                 report: FloorReport | None = None):  # fmt: skip
     """``settle`` on a Human's skin; returns (animation, (T,) shifts in metres)."""
     index = human.part_vertices("body")
     return settle(human.skeleton, human.vertices[index], human.weights.subset(index),
-                  animation, most_frames, per_frame)  # fmt: skip
+                  animation, most_frames, per_frame, report)  # fmt: skip
