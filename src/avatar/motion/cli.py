@@ -38,7 +38,8 @@ def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
                         help="keep the retargeted height (default: raise or lower the motion "
                         "so planted feet touch the floor with the body mesh)")  # fmt: skip
     parser.add_argument("--source-map", default="auto", metavar="NAME|FILE.json",
-                        help="source bone map: convention name or JSON file")  # fmt: skip
+                        help="source bone map: convention name, JSON file or topology "
+                        "(default: by names, the hierarchy where they fail)")  # fmt: skip
 
 
 def add_retarget_arguments(parser: argparse.ArgumentParser) -> None:
