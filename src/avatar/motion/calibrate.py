@@ -163,7 +163,7 @@ def _choose(out: np.ndarray, pairs: list[Pair], source: Skeleton, target: Skelet
         p, rt = pairs[k], target.rest[pairs[k].target, :3, :3]
         e_s = segment_rest(source, p.source, p.source_end)
         want = rt @ segment_rest(target, p.target, p.target_end)
-        g = geometry.swing(base @ e_s, want) @ base
+        g = _swing(base @ e_s, want) @ base
         rest_aligned = g.T @ rt
         if np.isnan(out[k, 0, 0]) or _degrees(rest_aligned, out[k]) < REST_TRUST:
             out[k] = rest_aligned
@@ -171,6 +171,18 @@ def _choose(out: np.ndarray, pairs: list[Pair], source: Skeleton, target: Skelet
 
 
 REST_TRUST = 45.0
+
+
+def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``geometry.swing`` for one pair of 3-vectors, with a handful of small operations
+    (it runs once per pair, in a sequential walk): R = I + [v] + [v]^2 / (1 + c)."""
+    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    c = float(a @ b)
+    if c < -1.0 + 1e-9:
+        return geometry.swing(a, b)
+    v = np.cross(a, b)
+    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    return np.eye(3) + k + (k @ k) / (1.0 + c)
 
 
 def _degrees(a: np.ndarray, b: np.ndarray) -> float:
