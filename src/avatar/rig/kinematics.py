@@ -8,6 +8,7 @@ cheaper than stacks of tiny matrix products); ``forward`` gives Blender's 4x4 ma
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from avatar.rig import quaternion
 from avatar.rig.skeleton import Skeleton
@@ -54,6 +55,7 @@ def world_pose(
     translations: np.ndarray | None = None,
     *,
     bones_first: bool = False,
+    dtype: npt.DTypeLike = np.float64,
 ) -> tuple[np.ndarray, np.ndarray]:
     """World bone rotations and heads for a pose (Blender's pose-bone evaluation).
 
@@ -61,12 +63,14 @@ def world_pose(
     translations: (..., J, 3) pose locations in each bone's rest frame, or None.
     bones_first: return the bone axis first, (J, ..., 4) and (J, ..., 3): the layout in
         which per-bone gathers over many frames are contiguous (what motion work wants).
+    dtype: of the computation and the results (float32 halves memory traffic on long
+        clips; rotations then carry errors of about 1e-5 degrees).
     Returns (..., J, 4) world rotations (bone frame -> world) and (..., J, 3) heads (metres).
     """
-    rest_rot, rest_step = _local_rest(skeleton)
+    rest_rot, rest_step = (a.astype(dtype) for a in _local_rest(skeleton))
     count = len(skeleton.names)
     batch = rotations.shape[:-2]
-    rot_in = np.moveaxis(rotations, -2, 0).reshape(count, -1, 4)  # (J, F, 4), F frames
+    rot_in = np.moveaxis(rotations, -2, 0).astype(dtype).reshape(count, -1, 4)  # (J, F, 4)
     local = rot_in @ quaternion.left_matrix(rest_rot)  # rest * rotation, per bone
     moved: dict[int, np.ndarray] = {}  # bone -> (F, 3) head in the parent's frame
     if translations is not None:
@@ -74,8 +78,8 @@ def world_pose(
         for j in range(count):
             if np.any(trans[j]):
                 moved[j] = rest_step[j] + quaternion.rotate(rest_rot[j], trans[j])
-    rot = np.empty(local.shape)
-    pos = np.empty(local.shape[:-1] + (3,))
+    rot = np.empty(local.shape, dtype)
+    pos = np.empty(local.shape[:-1] + (3,), dtype)
     parents = skeleton.parents
     for group in levels(parents):
         step = rest_step[group, None]  # (n, 1, 3): the same every frame unless translated

@@ -11,7 +11,7 @@ def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
     # Written component by component into one buffer: for the (T, J, 4) stacks of motion
     # work this is several times faster than a stack of 4x4 or 3x3 matrix products.
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))
     out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
     out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
     out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
@@ -52,7 +52,7 @@ def rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False) -> np.ndarray:
     tz = x * vy
     tz -= y * vx
     tz *= 2.0
-    out = np.empty(np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,))
+    out = np.empty(np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,), np.result_type(q, v))
     for k, (t, a, b, c, d) in enumerate(((tx, vx, y, tz, z * ty), (ty, vy, z, tx, x * tz),
                                          (tz, vz, x, ty, y * tx))):  # fmt: skip
         o = w * t
@@ -71,11 +71,11 @@ def between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     Opposite directions turn by half a turn about an axis perpendicular to a; a zero
     vector gives the identity.
     """
-    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+    a, b = np.broadcast_arrays(np.asarray(a), np.asarray(b))
     ax, ay, az, bx, by, bz = a[..., 0], a[..., 1], a[..., 2], b[..., 0], b[..., 1], b[..., 2]
     na = np.sqrt(ax * ax + ay * ay + az * az)
     ab = na * np.sqrt(bx * bx + by * by + bz * bz)
-    q = np.empty(a.shape[:-1] + (4,))
+    q = np.empty(a.shape[:-1] + (4,), np.result_type(a, b, np.float32))
     q[..., 0] = ab + ax * bx + ay * by + az * bz  # |a||b| (1 + cos): half-angle form, no trig
     q[..., 1] = ay * bz - az * by
     q[..., 2] = az * bx - ax * bz
