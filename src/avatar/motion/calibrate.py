@@ -180,8 +180,8 @@ def _swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     c = float(a @ b)
     if c < -1.0 + 1e-9:
         return geometry.swing(a, b)
-    v = np.cross(a, b)
-    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    x, y, z = a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
     return np.eye(3) + k + (k @ k) / (1.0 + c)
 
 

@@ -95,7 +95,7 @@ def between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def conjugate(q: np.ndarray) -> np.ndarray:
     """Inverse of a unit quaternion, (..., 4)."""
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+    return q * np.array([1.0, -1.0, -1.0, -1.0], dtype=np.result_type(q, np.float32))
 
 
 def to_matrix(q: np.ndarray) -> np.ndarray:
@@ -187,7 +187,7 @@ def to_euler(q: np.ndarray, order: str = "XYZ") -> np.ndarray:
 
 def slerp(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Spherical interpolation between unit quaternions (..., 4) at t (...,)."""
-    t = np.asarray(t, dtype=np.float64)[..., None]
+    t = np.asarray(t, dtype=np.result_type(a, b, np.float32))[..., None]
     dot = np.sum(a * b, axis=-1, keepdims=True)
     b = np.where(dot < 0, -b, b)
     dot = np.abs(dot)
