@@ -109,6 +109,7 @@ def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: f
     ankle = tmap.bones[f"foot.{side}"]
     offset = np.zeros((len(pinned), 3))
     weight = np.zeros(len(pinned))
+    near_floor = _NEAR_FLOOR * _leg(target, tmap, side)
     for role in ("foot", "toe"):
         j = tmap.bones.get(f"{role}.{side}")
         if j is None:
@@ -116,7 +117,7 @@ def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: f
         rest_z = target.heads[j, 2]
         for a, b in _runs(pinned == role):
             pin = pos[j, a:b].mean(axis=0)
-            if pin[2] - rest_z < _NEAR_FLOOR * _leg(target, tmap, side):
+            if pin[2] - rest_z < near_floor:
                 pin[2] = rest_z  # a floor contact: exactly on the floor
             offset[a:b] = pin - pos[j, a:b]
             weight[a:b] = 1.0

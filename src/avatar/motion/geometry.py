@@ -21,8 +21,11 @@ def unit(v: np.ndarray) -> np.ndarray:
 
 def angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(...,) angle in degrees between (..., 3) vectors (robust near 0 and 180)."""
-    a, b = unit(a), unit(b)
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, -1)))
+    a, b = np.broadcast_arrays(np.asarray(a), np.asarray(b))
+    ax, ay, az, bx, by, bz = a[..., 0], a[..., 1], a[..., 2], b[..., 0], b[..., 1], b[..., 2]
+    # atan2(|a x b|, a . b) needs no normalisation
+    cross = np.sqrt((ay * bz - az * by) ** 2 + (az * bx - ax * bz) ** 2 + (ax * by - ay * bx) ** 2)
+    return np.degrees(np.arctan2(cross, ax * bx + ay * by + az * bz + 0.0))  # no -0.0: 0 deg
 
 
 def swing(a: np.ndarray, b: np.ndarray) -> np.ndarray:
