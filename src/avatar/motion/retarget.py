@@ -346,8 +346,7 @@ def _to_local(target: Skeleton, world: np.ndarray, rigid: np.ndarray, hips: int,
     local /= np.copysign(np.sqrt(np.einsum("...i,...i->...", local, local)), local[..., 0])[
         ..., None
     ]  # unit (float32 work rounds the norm at 1e-7) with w >= 0
-    rotations = np.zeros((t, j, 4))
-    rotations[..., 0] = 1.0
+    rotations = np.tile(np.array([1.0, 0.0, 0.0, 0.0]), (t, j, 1))  # identity everywhere
     # Bone-major -> frame-major, moving whole quaternions (32-byte items): ~3x faster than
     # numpy's strided copy of single floats.
     whole = np.dtype((np.void, 32))
