@@ -280,6 +280,7 @@ def long_cards(
     width: float = 0.026,
     layers=(0.004, 0.024),
     seed: int = 1,
+    samples: int = 16,
 ) -> Piece:
     """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
     stacked at random heights between ``layers`` (m) off the guides, of random length.
@@ -288,7 +289,7 @@ def long_cards(
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
     """
     rng = np.random.default_rng([seed, count])
-    g = guides(body)
+    g = guides(body, samples)
     pairs = [(i, i + 1) for i in range(len(g) - 1)
              if np.linalg.norm(g[i, -1] - g[i + 1, -1]) < 0.15]  # fmt: skip
     pick = rng.integers(0, len(pairs), count)

@@ -163,7 +163,7 @@ def strand_shade(size: int, seed: int = 0) -> np.ndarray:
     strand = locks * rng.uniform(0.82, 1.18, size)
     half = size // 2
     t = (np.arange(size - half) + 0.5) / (size - half)  # 0 at the roots, 1 at the tips
-    along = np.concatenate([np.full(half, 0.6), 0.6 + 0.65 * t**0.8])
+    along = np.concatenate([np.full(half, 0.72), 0.6 + 0.65 * t**0.8])
     return (along[:, None] * strand[None, :]).astype(np.float32)
 
 
