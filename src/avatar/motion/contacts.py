@@ -114,13 +114,17 @@ def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: f
         j = tmap.bones.get(f"{role}.{side}")
         if j is None:
             continue
+        down = pinned == role
+        runs = np.array(_runs(down), dtype=int).reshape(-1, 2)
+        if not len(runs):
+            continue
+        # each run's mean position, from running sums (all runs at once)
+        total = np.concatenate([np.zeros((1, 3)), np.cumsum(pos[j], axis=0, dtype=np.float64)])
+        pin = (total[runs[:, 1]] - total[runs[:, 0]]) / (runs[:, 1] - runs[:, 0])[:, None]
         rest_z = target.heads[j, 2]
-        for a, b in _runs(pinned == role):
-            pin = pos[j, a:b].mean(axis=0)
-            if pin[2] - rest_z < near_floor:
-                pin[2] = rest_z  # a floor contact: exactly on the floor
-            offset[a:b] = pin - pos[j, a:b]
-            weight[a:b] = 1.0
+        pin[:, 2] = np.where(pin[:, 2] - rest_z < near_floor, rest_z, pin[:, 2])  # on the floor
+        offset[down] = np.repeat(pin, runs[:, 1] - runs[:, 0], axis=0) - pos[j, down]
+        weight[down] = 1.0
     if not weight.any():
         return None
     offset, weight = _blend(offset, weight, max(1, int(round(_BLEND_S * fps))))

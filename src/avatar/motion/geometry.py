@@ -72,15 +72,17 @@ def offsets(skeleton: Skeleton) -> np.ndarray:
 
 def positions(skeleton: Skeleton, world: np.ndarray, roots: dict[int, np.ndarray],
               bones: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
-    """(J, T, 3) bone heads from world bone rotations (J, T, 4) (bone axis first).
+    """(J, T, 3) bone heads (float64) from world bone rotations (J, T, 4) (bone axis first).
 
     roots: bone index -> (T, 3) head positions of bones placed directly (translated bones);
     other parentless bones stay at their rest heads.
-    bones: (J,) bool of the bones to evaluate (closed under parents); others are NaN.
+    bones: (J,) bool of the bones to evaluate (closed under parents); rows of the others
+    are left undefined (no memory touched) and marked NaN in frame 0.
     """
     off = offsets(skeleton)
     parents = skeleton.parents
-    out = np.full(world.shape[:-1] + (3,), np.nan)
+    out = np.empty(world.shape[:-1] + (3,))  # float64: leg IK solves triangles from these
+    out[:, 0] = np.nan
     for group in levels(parents, bones):
         p = parents[group]
         if p[0] < 0:
