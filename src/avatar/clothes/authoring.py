@@ -65,20 +65,29 @@ class Piece:
     binding: Binding
 
 
-def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease, relax: int = 0) -> Mesh:
+def cut(
+    body: AuthoringBody,
+    faces: np.ndarray,
+    keep: np.ndarray,
+    ease,
+    relax: int = 0,
+    loose: bool = False,
+) -> Mesh:
     """A surface of the chosen faces, pushed ``ease`` metres out along the skin normal.
 
     faces: (F, 4) base-mesh faces of the source surface; keep: (F,) bool.
     ease: float or callable (points (N, 3), arm (N,), leg (N,)) -> (N,) metres.
     relax: smoothing passes over the cut's edges (``relax_boundary``); 0 keeps the mesh's
     staircase of whole faces.
+    loose: ease along the source surface's own normal (``surface_normals``, for a surface
+    standing off the body such as ``helper-skirt``), else along the skin's.
     Returns a Mesh (own vertex numbering) with box-projected UVs; faces face outward.
     """
     chosen = faces[keep]
     used, inverse = np.unique(chosen, return_inverse=True)
     points = body.vertices[used]
     local = inverse.reshape(chosen.shape).astype(np.int32)
-    normals = surface_normals(body, faces)[used]
+    normals = surface_normals(body, faces)[used] if loose else body.outward(points)
     if relax:
         points = relax_boundary(points, local, normals, relax)
     if callable(ease):
@@ -91,7 +100,8 @@ def cut(body: AuthoringBody, faces: np.ndarray, keep: np.ndarray, ease, relax: i
 def surface_normals(body: AuthoringBody, faces: np.ndarray) -> np.ndarray:
     """(V, 3) unit vertex normals of a source surface (base-mesh faces), turned to face away
     from the body. Easing along the surface's own normal keeps a loose surface smooth: the
-    skin's normal would push neighbours of a skirt between the legs towards opposite legs."""
+    skin's normal would push neighbours of a skirt between the legs towards opposite legs.
+    (A body-hugging surface eases along the skin's: its own folds into the crotch.)"""
     normals = vertex_normals(body.vertices.astype(np.float32), faces).astype(np.float64)
     used = np.unique(faces)
     agree = np.einsum("nd,nd->n", normals[used], body.outward(body.vertices[used]))

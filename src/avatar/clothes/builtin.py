@@ -52,7 +52,7 @@ def _tights(body: AuthoringBody, keep_fn, ease) -> Piece:
 def _skirt(body: AuthoringBody, bottom_z: float, ease) -> Piece:
     faces = body.group_faces("helper-skirt")
     centre_z = body.vertices[faces].mean(axis=1)[:, 2]
-    return bound(body, cut(body, faces, centre_z > bottom_z, ease, relax=RELAX), faces)
+    return bound(body, cut(body, faces, centre_z > bottom_z, ease, RELAX, loose=True), faces)
 
 
 def _z(ff):
