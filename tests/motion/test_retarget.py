@@ -152,3 +152,12 @@ def test_quality_targets_on_every_fixture_clip(target, clip):
     q = report.quality
     assert q.direction_median < 2.0 and q.direction_p95 < 5.0, q.summary()
     assert q.skating_cm < 1.0, q.summary()
+
+
+@needs_fixtures
+def test_hand_and_finger_base_starting_at_the_wrist_both_follow_the_source(reference):
+    """CMU's finger base starts at the wrist: the hand's segment runs over the finger bone,
+    which has its own pair. Both segments land on the source's directions."""
+    per_bone = reference[1].quality.per_bone
+    for side in "LR":
+        assert per_bone[f"hand.{side}"] < 0.05 and per_bone[f"middle1.{side}"] < 0.05, per_bone
