@@ -4,13 +4,17 @@ Steps (``retarget``):
 1. select frames and resample to the wanted fps (source side, before anything else);
 2. source forward kinematics: world bone rotations and heads per frame;
 3. bone maps on both sides -> pairs of bones (canonical roles + identical names);
-4. per-pair rest alignment ``A`` (``calibrate``): target world = source world @ A;
+4. per-pair rest alignment ``A`` (``calibrate``): target world = source world * A;
 5. transfer: mapped bones take the source's world rotation, turned per frame onto the
    source segment's direction; unmapped bones follow their parent; spine and neck chains
    of different lengths share the bend;
 6. root path: the hips follow the source's, scaled by leg length, standing on the floor;
 7. feet: contacts detected on the source stay planted on the target (two-bone leg IK);
 8. world rotations -> pose-bone rotations/locations; quality metrics for the report.
+
+Per-frame arrays are quaternions and 3-vectors with the bone axis first, (J, T, 4) and
+(J, T, 3), in float32 (see docs/benchmarks.md "Motion" for why); only bones that carry
+driven bones or segment ends are evaluated.
 """
 
 from __future__ import annotations
