@@ -43,7 +43,9 @@ def test_lbs_equals_dqs_for_pure_translations(human):
 def test_dqs_preserves_volume_under_twist_better_than_lbs(human):
     sk = human.skeleton
     rot = np.tile([1.0, 0, 0, 0], (1, len(sk.names), 1))
-    rot[0, sk.index("lowerarm01.L")] = quaternion.from_axis_angle(np.array([0, 1.0, 0]), np.pi * 0.8)
+    rot[0, sk.index("lowerarm01.L")] = quaternion.from_axis_angle(
+        np.array([0, 1.0, 0]), np.pi * 0.8
+    )
     world = kinematics.forward(sk, rot)
     mats = kinematics.skinning_matrices(sk, world)
     wrist = human.weights.dense(len(sk.names))[:, sk.index("lowerarm01.L")] > 0.3
