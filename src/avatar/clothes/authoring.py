@@ -94,7 +94,8 @@ def cut(
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
     points = points + np.asarray(ease)[..., None] * normals
-    return with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+    mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+    return with_limb_uvs(mesh, body.part[used], body.marks)
 
 
 def surface_normals(body: AuthoringBody, faces: np.ndarray) -> np.ndarray:
@@ -181,6 +182,48 @@ def with_box_uvs(mesh: Mesh, tile: float = TILE_METRES) -> Mesh:
     return Mesh(mesh.vertices, f, uvs.astype(np.float32), face_uvs)
 
 
+def with_limb_uvs(mesh: Mesh, part: np.ndarray, marks, tile: float = TILE_METRES) -> Mesh:
+    """Sleeves and trouser legs get cylinder UVs: u around the limb, v along it (in tiles).
+
+    Box projection changes axis around a limb, which shows as seams where the weave turns;
+    around a cylinder the fabric runs on, with one seam along the limb's underside.
+    part: (V,) body part of each vertex; faces all of whose corners are "arm" (or "leg")
+    are re-mapped, the rest keep their UVs.
+    """
+    assert mesh.uvs is not None, "with_limb_uvs re-maps per-corner UVs (with_box_uvs)"
+    v = mesh.vertices.astype(np.float64)
+    uvs = mesh.uvs.copy().reshape(mesh.faces.shape + (2,))
+    for name, joints in (("arm", (marks.shoulder, marks.elbow, marks.wrist)),
+                         ("leg", (marks.hip, marks.knee, marks.ankle))):  # fmt: skip
+        faces = np.flatnonzero((part[mesh.faces] == name).all(axis=1))
+        if len(faces) == 0:
+            continue
+        corners = v[mesh.faces[faces]]  # (F, C, 3)
+        side = (corners.mean(axis=1)[:, 0] < 0).astype(int)  # 0: left (+x), 1: right
+        a, b, c = (j[side][:, None, :] for j in joints)
+        t = np.einsum("fcd,fcd->fc", corners - a, b - a) / np.einsum("fcd,fcd->fc", b - a, b - a)
+        lower = t > 1
+        start = np.where(lower[..., None], b, a)
+        axis = np.where(lower[..., None], c - b, b - a)
+        along = np.where(lower, np.linalg.norm(b - a, axis=-1), 0) + np.einsum(
+            "fcd,fcd->fc", corners - start, axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+        )
+        direction = axis / np.linalg.norm(axis, axis=-1, keepdims=True)
+        radial = corners - start
+        radial -= np.einsum("fcd,fcd->fc", radial, direction)[..., None] * direction
+        front = np.cross(direction, [0.0, 0.0, 1.0]) if name == "arm" else np.array([0, -1.0, 0])
+        front = front - np.einsum("...d,...d->...", front, direction)[..., None] * direction
+        front /= np.linalg.norm(front, axis=-1, keepdims=True)
+        up = np.cross(direction, front)
+        angle = np.arctan2(np.einsum("fcd,fcd->fc", radial, up),
+                           np.einsum("fcd,fcd->fc", radial, front))  # fmt: skip
+        # One seam, at the angle facing away from the front; faces across it unwrapped.
+        angle = np.where(angle.max(axis=1, keepdims=True) - angle > np.pi, angle + 2 * np.pi, angle)
+        radius = np.linalg.norm(radial, axis=-1)  # per corner: a vertex maps the same in each face
+        uvs[faces] = np.stack([angle * radius, -along], -1) / tile
+    return Mesh(mesh.vertices, mesh.faces, uvs.reshape(-1, 2).astype(np.float32), mesh.face_uvs)
+
+
 def bound(body: AuthoringBody, mesh: Mesh, surface_faces: np.ndarray) -> Piece:
     """Bind a mesh on the authoring body to a surface (base-mesh faces)."""
     return Piece(mesh, bind(mesh.vertices, body.vertices, surface_faces))
@@ -205,12 +248,14 @@ def single_references(body: AuthoringBody, group: str, uvs_from_base: bool = Tru
 def join(pieces: list[Piece]) -> Piece:
     """One garment from several pieces (e.g. a dress's bodice and skirt)."""
     meshes = [p.mesh for p in pieces]
-    offset = np.cumsum([0] + [len(m.vertices) for m in meshes])
-    uv_offset = np.cumsum([0] + [len(m.uvs) for m in meshes])
+    if any(m.uvs is None or m.face_uvs is None for m in meshes):
+        raise ValueError("join needs pieces with UVs")
+    offset = np.cumsum([0, *(len(m.vertices) for m in meshes)])
+    uv_offset = np.cumsum([0, *(len(m.uvs) for m in meshes)])  # type: ignore[arg-type]
     width = max(m.faces.shape[1] for m in meshes)
     faces = np.concatenate([_pad(m.faces, width) + o for m, o in zip(meshes, offset, strict=False)])
     fuv = np.concatenate(
-        [_pad(m.face_uvs, width) + o for m, o in zip(meshes, uv_offset, strict=False)]
+        [_pad(m.face_uvs, width) + o for m, o in zip(meshes, uv_offset, strict=False)]  # type: ignore[arg-type]
     )
     mesh = Mesh(
         np.concatenate([m.vertices for m in meshes]),

@@ -56,7 +56,8 @@ COLOURS = {
 
 def _grid(size: int) -> tuple[np.ndarray, np.ndarray]:
     t = np.arange(size, dtype=np.float32) * (2 * np.pi / size)
-    return np.meshgrid(t, t, indexing="xy")
+    u, v = np.meshgrid(t, t, indexing="xy")
+    return u, v
 
 
 def _noise(size: int, rng: np.random.Generator, low: int, high: int) -> np.ndarray:

@@ -185,7 +185,7 @@ def grow_cards(
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
     top *= rng.uniform(0.55, 1.0, count)
     # Short at the hairline (a fringe would hang over the face), full length further in.
-    size = rng.uniform(*length, count) * (0.45 + 0.55 * np.clip(depth / 0.04, 0, 1))
+    size = rng.uniform(length[0], length[1], count) * (0.45 + 0.55 * np.clip(depth / 0.04, 0, 1))
     rows = [roots]
     point = roots
     for k in range(1, segments + 1):
@@ -304,7 +304,7 @@ def long_cards(
     n = np.arange(count)[:, None]
     path = (1 - frac) * path[n, lo] + frac * path[n, lo + 1]
     t = np.linspace(0, 1, k)[None, :, None]
-    height = rng.uniform(*layers, count)[:, None, None] * np.sqrt(t)
+    height = rng.uniform(layers[0], layers[1], count)[:, None, None] * np.sqrt(t)
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
@@ -386,6 +386,6 @@ def orient_up(mesh: Mesh) -> Mesh:
     flip = n[:, 2] < 0
     faces = mesh.faces.copy()
     faces[flip] = faces[flip][:, [2, 1, 0, 3]]
-    fuv = mesh.face_uvs.copy()
+    fuv = faces.copy() if mesh.face_uvs is None else mesh.face_uvs.copy()
     fuv[flip] = fuv[flip][:, [2, 1, 0, 3]]
     return Mesh(mesh.vertices, faces, mesh.uvs, fuv)
