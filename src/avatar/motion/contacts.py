@@ -24,6 +24,8 @@ _SPEED = 0.15  # leg lengths per second
 _NEAR_FLOOR = 0.06  # leg lengths: a contact this close to the floor is put on it
 _MIN_CONTACT_S = 0.05
 _BLEND_S = 0.1
+_STRAIGHT = np.sin(np.radians(0.1))  # knee bends below this have no plane of their own
+_BACK = np.array([0.0, 1.0, 0.0])  # Avatar characters face -Y: knees bend toward +Y
 
 
 @dataclass(frozen=True)
@@ -155,10 +157,13 @@ def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int,
     l1 = np.linalg.norm(k - h, axis=-1)
     l2 = np.linalg.norm(a - k, axis=-1)
     hinge = np.cross(a - k, h - k)
-    weak = np.linalg.norm(hinge, axis=-1) < 1e-6 * l1 * l2
-    x_axis = quaternion.rotate(world[thigh], np.array([1.0, 0.0, 0.0]))
-    hinge = np.where(weak[:, None], x_axis, hinge)  # straight leg: bone X
-    hinge = geometry.unit(hinge)
+    # A (nearly) straight leg has no bending plane of its own (the cross product is
+    # rounding noise): bend it about the knee's hinge, the rest knee axis (knees bend
+    # toward +Y) carried by the thigh.
+    weak = np.linalg.norm(hinge, axis=-1) < _STRAIGHT * l1 * l2
+    rest_knee = geometry.unit(np.cross(target.heads[shin] - target.heads[thigh], _BACK))
+    knee = quaternion.rotate(world[thigh], target.rest[thigh, :3, :3].T @ rest_knee)
+    hinge = geometry.unit(np.where(weak[:, None], knee, hinge))
     reach = np.clip(np.linalg.norm(goal - h, axis=-1), np.abs(l1 - l2) + 1e-6, l1 + l2 - 1e-6)
     cur = np.radians(geometry.angle(h - k, a - k))
     want = np.arccos(np.clip((l1**2 + l2**2 - reach**2) / (2 * l1 * l2), -1, 1))

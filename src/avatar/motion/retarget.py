@@ -115,7 +115,7 @@ def retarget(
     tmap = bonemap.detect(target_skeleton, target_map)
     pairs = make_pairs(source_skeleton, smap, target_skeleton, tmap, match_names)
     src_seg = segments(source_skeleton, src.rot, src.pos, [p.source for p in pairs],
-                       [p.source_end for p in pairs])  # fmt: skip
+                       [p.source_end for p in pairs]).astype(_WORK_TYPE)  # fmt: skip
     align = calibrate.offsets(pairs, source_skeleton, src.rot, src.pos, target_skeleton, src_seg)
     world, rigid = _transfer(pairs, align, src, src_seg, target_skeleton)
     scale = _leg_length(target_skeleton, tmap) / _leg_length(source_skeleton, smap)
@@ -202,7 +202,8 @@ def _aims(pairs: list[Pair], src: _Source, src_seg: np.ndarray, target: Skeleton
         chain = geometry.path(target, a.target, b.target)
         if len(chain) >= 2:
             want = src.pos[b.source] - src.pos[a.source]
-            out.append(_rigid_folded(_Aim(chain[:-1], off[chain[1:]], want), rigid, local))
+            aim = _Aim(chain[:-1], off[chain[1:]], want.astype(_WORK_TYPE))
+            out.append(_rigid_folded(aim, rigid, local))
     limbs = [k for k in sorted(range(len(pairs)), key=lambda k: pairs[k].target)
              if pairs[k].kind != "trunk" and not pairs[k].role.startswith("=")]  # fmt: skip
     aimed = {pairs[k].target for k in limbs}  # same-named extras keep their twist

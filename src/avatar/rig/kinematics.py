@@ -63,11 +63,13 @@ def world_pose(
     translations: (..., J, 3) pose locations in each bone's rest frame, or None.
     bones_first: return the bone axis first, (J, ..., 4) and (J, ..., 3): the layout in
         which per-bone gathers over many frames are contiguous (what motion work wants).
-    dtype: of the computation and the results (float32 halves memory traffic on long
-        clips; rotations then carry errors of about 1e-5 degrees).
+    dtype: of the rotations (float32 halves memory traffic on long clips; rotations then
+        carry errors of about 1e-5 degrees). Heads are float64 whatever it is: they add up
+        along the hierarchy and may be far from the origin.
     Returns (..., J, 4) world rotations (bone frame -> world) and (..., J, 3) heads (metres).
     """
-    rest_rot, rest_step = (a.astype(dtype) for a in _local_rest(skeleton))
+    rest_rot, rest_step = _local_rest(skeleton)
+    rest_rot = rest_rot.astype(dtype)
     count = len(skeleton.names)
     batch = rotations.shape[:-2]
     rot_in = np.moveaxis(rotations, -2, 0).astype(dtype).reshape(count, -1, 4)  # (J, F, 4)
@@ -79,7 +81,7 @@ def world_pose(
             if np.any(trans[j]):
                 moved[j] = rest_step[j] + quaternion.rotate(rest_rot[j], trans[j])
     rot = np.empty(local.shape, dtype)
-    pos = np.empty(local.shape[:-1] + (3,), dtype)
+    pos = np.empty(local.shape[:-1] + (3,))
     parents = skeleton.parents
     for group in levels(parents):
         step = rest_step[group, None]  # (n, 1, 3): the same every frame unless translated
