@@ -134,14 +134,20 @@ def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: f
 
 
 def _blend(offset: np.ndarray, weight: np.ndarray, n: int):
-    """Carry each contact's boundary offset into the free frames around it, fading out."""
+    """Carry each contact's boundary offset into the free frames around it, fading out
+    over ``n`` frames (the nearest contact wins; on a tie, the one before)."""
+    frames = np.arange(len(weight))
+    on = weight > 0
+    before = np.maximum.accumulate(np.where(on, frames, -1))  # last contact frame so far
+    after = np.minimum.accumulate(np.where(on, frames, len(weight))[::-1])[::-1]
+    d_before = np.where(before >= 0, frames - before, len(weight) + n)
+    d_after = np.where(after < len(weight), after - frames, len(weight) + n)
+    use_before = d_before <= d_after
+    gap = np.where(use_before, d_before, d_after)
+    near = ~on & (gap <= n)
     out_o, out_w = offset.copy(), weight.copy()
-    for a, b in _runs(weight > 0):
-        for k in range(1, n + 1):
-            fade = 1.0 - k / (n + 1)
-            for f, src in ((a - k, a), (b - 1 + k, b - 1)):
-                if 0 <= f < len(weight) and weight[f] == 0 and fade > out_w[f]:
-                    out_o[f], out_w[f] = offset[src], fade
+    out_w[near] = 1.0 - gap[near] / (n + 1)
+    out_o[near] = offset[np.where(use_before, before, after)[near]]
     return out_o, out_w
 
 
