@@ -1,4 +1,7 @@
-"""Quaternion maths on arrays, (w, x, y, z), batch dimensions leading."""
+"""Quaternion maths on arrays, (w, x, y, z), batch dimensions leading.
+
+Results keep their inputs' precision (float32 stays float32; anything else is float64).
+"""
 
 from __future__ import annotations
 
@@ -11,7 +14,7 @@ def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
     # Written component by component into one buffer: for the (T, J, 4) stacks of motion
     # work this is several times faster than a stack of 4x4 or 3x3 matrix products.
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b, np.float32))
     out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
     out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
     out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
@@ -52,7 +55,9 @@ def rotate(q: np.ndarray, v: np.ndarray, inverse: bool = False) -> np.ndarray:
     tz = x * vy
     tz -= y * vx
     tz *= 2.0
-    out = np.empty(np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,), np.result_type(q, v))
+    out = np.empty(
+        np.broadcast_shapes(q.shape[:-1], v.shape[:-1]) + (3,), np.result_type(q, v, np.float32)
+    )
     for k, (t, a, b, c, d) in enumerate(((tx, vx, y, tz, z * ty), (ty, vy, z, tx, x * tz),
                                          (tz, vz, x, ty, y * tx))):  # fmt: skip
         o = w * t
