@@ -81,21 +81,27 @@ def bottom(length: float, rise: float = 0.07):
     return keep
 
 
-def tank(ff, m):
-    """Torso on straps: a neckline scooped deeper in front than behind, oval armholes
-    reaching a hand's width below the shoulder joint (shoulder faces count as arm)."""
-    x, y, z = ff.centre.T
-    across, shoulder_x = np.abs(x), abs(m.shoulder[0, 0])
-    armhole = ((across - shoulder_x) / 0.062) ** 2 + ((z - m.shoulder[0, 2] - 0.05) / 0.15) ** 2
-    depth = np.where(y < m.neck[1], 0.12, 0.05)
-    neckline = m.neck[2] - depth * np.sqrt(np.clip(1 - (across / 0.07) ** 2, 0, 1))
-    upper = (ff.part == "torso") | ((ff.part == "arm") & (across < shoulder_x - 0.03))
-    body = upper & (z > m.hip[0, 2] + 0.04) & (armhole > 1) & (across < shoulder_x)
-    return body & ~((across < 0.07) & (z > neckline))
+def strapped(hem: float, armhole: float = 0.062, front: float = 0.12, back: float = 0.05):
+    """Torso on straps down to ``hem`` m above the hip joints: a neckline scooped ``front``
+    and ``back`` m below the neck joint, oval armholes ``armhole`` m in from the shoulder
+    joint reaching a hand's width below it (shoulder faces count as arm)."""
+
+    def keep(ff, m):
+        x, y, z = ff.centre.T
+        across, shoulder_x = np.abs(x), abs(m.shoulder[0, 0])
+        hole = ((across - shoulder_x) / armhole) ** 2 + ((z - m.shoulder[0, 2] - 0.05) / 0.15) ** 2
+        depth = np.where(y < m.neck[1], front, back)
+        neckline = m.neck[2] - depth * np.sqrt(np.clip(1 - (across / 0.07) ** 2, 0, 1))
+        upper = (ff.part == "torso") | ((ff.part == "arm") & (across < shoulder_x - 0.03))
+        body = upper & (z > m.hip[0, 2] + hem) & (hole > 1) & (across < shoulder_x)
+        return body & ~((across < 0.07) & (z > neckline))
+
+    return keep
 
 
-def swimsuit(ff, m):
-    return (ff.part == "torso") & (_z(ff) < m.chest_z + 0.11) & (_z(ff) > m.hip[0, 2] - 0.15)
+tank = strapped(0.04)
+# A one-piece: high-cut legs (the torso faces end at the groin), narrow straps, deep neck.
+swimsuit = strapped(-0.15, armhole=0.072, front=0.15, back=0.13)
 
 
 def socks(ff, m):
