@@ -164,8 +164,8 @@ SPECS = [
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
-    Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown(), 380, width=0.02, segments=3)]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
-    Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b, 300, 0.03, samples=10)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
+    Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
+    Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 320, (0.08, 0.14), 0.025, (0.003, 0.008), 4), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
     Spec("eyebrows", "face", face.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
     Spec("eyebrows-blond", "face", face.eyebrows, "hair", "blond hair", 0.0, 5, ("eyebrows", "blond"), False),  # noqa: E501

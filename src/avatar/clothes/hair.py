@@ -164,11 +164,11 @@ def flow_tied(tie_offset=(0.0, 0.07, 0.0)):
 def grow_cards(
     body: AuthoringBody,
     flow,
-    count: int = 700,
+    count: int = 380,
     length=(0.035, 0.055),
-    width: float = 0.015,
+    width: float = 0.02,
     lift=(0.006, 0.022),
-    segments: int = 4,
+    segments: int = 3,
     seed: int = 0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
@@ -276,11 +276,11 @@ def _resample(line: np.ndarray, samples: int) -> np.ndarray:
 
 def long_cards(
     body: AuthoringBody,
-    count: int = 420,
-    width: float = 0.026,
+    count: int = 300,
+    width: float = 0.03,
     layers=(0.004, 0.024),
     seed: int = 1,
-    samples: int = 16,
+    samples: int = 10,
 ) -> Piece:
     """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
     stacked at random heights between ``layers`` (m) off the guides, of random length.
