@@ -83,7 +83,14 @@ from avatar.mesh import Mesh  # noqa: E402
 log = logging.getLogger(__name__)
 
 CACHE_FORMAT = 2  # bump whenever the compiled layout changes
-RIG_NAMES = ("default", "default_no_toes", "game_engine", "game_engine_with_breast", "cmu_mb", "mixamo")
+RIG_NAMES = (
+    "default",
+    "default_no_toes",
+    "game_engine",
+    "game_engine_with_breast",
+    "cmu_mb",
+    "mixamo",
+)
 # The default_no_toes rig ships without weights of its own: MakeHuman uses the default rig's.
 WEIGHTS_FILE = {"default_no_toes": "default"}
 
@@ -132,9 +139,11 @@ def parse_target(text: str, path: str | Path) -> tuple[np.ndarray, np.ndarray]:
                 except ValueError:
                     raise FormatError(path, lineno, f"non-numeric value in {s[:60]!r}") from None
         raise
-    bad = ~np.isfinite(table).all(axis=1) | (table[:, 0] < 0) | (table[:, 0] != np.round(table[:, 0]))
+    index = table[:, 0]
+    bad = ~np.isfinite(table).all(axis=1) | (index < 0) | (index != np.round(index))
     if bad.any():
-        raise FormatError(path, _data_line(text, int(np.argmax(bad))), "bad index or non-finite offset")
+        bad_line = _data_line(text, int(np.argmax(bad)))
+        raise FormatError(path, bad_line, "bad index or non-finite offset")
     d = table[:, 1:]
     delta = np.stack([d[:, 0], -d[:, 2], d[:, 1]], axis=1) * 0.1
     return table[:, 0].astype(np.int32), delta.astype(np.float32)
@@ -177,10 +186,13 @@ class CompiledAssets:
         a = self.arrays
         names = self.meta["groups"]
         bounds = a["group_offsets"]
-        groups = {n: np.asarray(a["group_index"][bounds[i] : bounds[i + 1]]) for i, n in enumerate(names)}
+        groups = {
+            n: np.asarray(a["group_index"][bounds[i] : bounds[i + 1]]) for i, n in enumerate(names)
+        }
         fbounds = a["face_group_offsets"]
         face_groups = {
-            n: np.asarray(a["face_group_index"][fbounds[i] : fbounds[i + 1]]) for i, n in enumerate(names)
+            n: np.asarray(a["face_group_index"][fbounds[i] : fbounds[i + 1]])
+            for i, n in enumerate(names)
         }
         return Mesh(
             vertices=np.asarray(a["base_vertices"]),
@@ -256,7 +268,8 @@ def _compile_base(root: Path, arrays: dict[str, np.ndarray], meta: dict) -> None
     except FormatError as exc:
         raise AssetError(f"corrupt base mesh: {exc}\n{INSTALL_HINT}") from None
     if len(mesh.vertices) != 19158 or mesh.uvs is None or mesh.face_uvs is None:
-        raise AssetError(f"{root / '3dobjs/base.obj'} is not MakeHuman's hm08 base mesh\n{INSTALL_HINT}")
+        base = root / "3dobjs/base.obj"
+        raise AssetError(f"{base} is not MakeHuman's hm08 base mesh\n{INSTALL_HINT}")
     arrays["base_vertices"] = mesh.vertices
     arrays["base_faces"] = mesh.faces
     arrays["base_uvs"] = mesh.uvs
@@ -264,7 +277,8 @@ def _compile_base(root: Path, arrays: dict[str, np.ndarray], meta: dict) -> None
     names = list(mesh.groups)
     meta["groups"] = names
     arrays["group_index"], arrays["group_offsets"] = _concat([mesh.groups[n] for n in names])
-    arrays["face_group_index"], arrays["face_group_offsets"] = _concat([mesh.face_groups[n] for n in names])
+    face_groups = _concat([mesh.face_groups[n] for n in names])
+    arrays["face_group_index"], arrays["face_group_offsets"] = face_groups
 
 
 def _concat(parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -275,7 +289,8 @@ def _concat(parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def target_files(root: Path) -> dict[str, Path]:
-    """Target name -> file, e.g. ``macrodetails/universal-female-young-...``, ``faceunits/jawOpen``."""
+    """Target name -> file, e.g. ``macrodetails/universal-female-young-...``,
+    ``faceunits/jawOpen``."""
     files = {}
     for path in sorted((root / "targets").rglob("*.target*")):
         rel = path.relative_to(root / "targets").as_posix()

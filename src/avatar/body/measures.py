@@ -135,8 +135,13 @@ DRIVERS = {
 }
 
 
-def fit(model, targets: Mapping[str, float], params: Mapping[str, float] | None = None,
-        iterations: int = 8, tolerance: float = 0.002) -> tuple[dict[str, float], dict[str, float]]:  # fmt: skip
+def fit(
+    model,
+    targets: Mapping[str, float],
+    params: Mapping[str, float] | None = None,
+    iterations: int = 8,
+    tolerance: float = 0.002,
+) -> tuple[dict[str, float], dict[str, float]]:
     """Solve for parameters giving target measurements (metres: height, chest, waist, hips).
 
     Damped Gauss-Newton over the ``DRIVERS`` of the requested measurements, starting from

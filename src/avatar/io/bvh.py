@@ -621,7 +621,7 @@ def to_animation(data: BvhData, unit: str | float = "auto", up: str = "auto",
     delta = local_translations(data, positions) @ c.T * s - offsets
     translations = np.einsum("jba,tjb->tja", rest[:, :3, :3], delta)  # R0^T delta
     translations[np.abs(translations) < 1e-12] = 0.0
-    extra = {"bvh_unit": unit, "bvh_up": up}
+    extra: dict[str, object] = {"bvh_unit": unit, "bvh_up": up}
     skeleton = Skeleton(data.names, data.parents.copy(), rest, tails, extra)
     return skeleton, Animation(rotations, translations, data.fps, data.names)
 

@@ -50,12 +50,16 @@ class RigDefinition:
         return cls(
             name=name,
             names=tuple(order),
-            parents=np.array([index.get(bones[b].get("parent") or "", -1) for b in order], np.int32),
+            parents=np.array(
+                [index.get(bones[b].get("parent") or "", -1) for b in order], np.int32
+            ),
             rolls=np.array([float(bones[b].get("roll", 0.0)) for b in order]),
             vertex=vertex,
             axis=axis,
             offsets=np.array([e.get("offset", (0.0, 0.0, 0.0)) for e in ends], dtype=np.float64),
-            defaults=np.array([e.get("default_position", (0.0, 0.0, 0.0)) for e in ends], np.float64),
+            defaults=np.array(
+                [e.get("default_position", (0.0, 0.0, 0.0)) for e in ends], np.float64
+            ),
         )
 
     @cached_property

@@ -143,7 +143,7 @@ def from_matrix(m: np.ndarray) -> np.ndarray:
     return np.where(q[..., :1] < 0, -q, q)
 
 
-def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def from_axis_angle(axis: np.ndarray, angle: np.ndarray | float) -> np.ndarray:
     """Rotation of ``angle`` radians (...,) about unit ``axis`` (..., 3) -> (..., 4)."""
     axis = np.asarray(axis, dtype=np.float64)
     half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
