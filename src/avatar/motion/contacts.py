@@ -38,9 +38,10 @@ class FootContacts:
         return self.pinned[side] != ""
 
 
-def foot_level(pos: np.ndarray, bmap: BoneMap) -> float:
-    """Height of the lowest foot joint when down (5th percentile over frames), metres."""
-    idx = [bmap.bones[r] for r in FOOT_ROLES if r in bmap.bones]
+def foot_level(pos: np.ndarray, bmap: BoneMap, roles: tuple[str, ...] = FOOT_ROLES) -> float:
+    """Height of the lowest foot joint (of ``roles``) when down: the 5th percentile over
+    frames of (T, J, 3) heads ``pos``, metres."""
+    idx = [bmap.bones[r] for r in roles if r in bmap.bones]
     if not idx:
         return float(np.percentile(pos[..., 2].min(axis=1), 5))
     return float(np.percentile(pos[:, idx, 2].min(axis=1), 5))
@@ -180,3 +181,78 @@ def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int,
     lower = geometry.path(target, shin, foot)[:-1]
     world[upper] = quaternion.multiply(turn, world[upper])
     world[lower] = quaternion.multiply(quaternion.multiply(turn, bend), world[lower])
+
+
+# Sole points of a foot, from its joints alone (the retargeter has no mesh): behind the
+# ankle by this fraction of the ankle's height (MakeHuman's heel: 5 cm behind a 7 cm high
+# ankle), and to each side of the ball by this fraction of the ankle-to-ball distance.
+_HEEL_BACK = 0.6
+_HALF_WIDTH = 0.3
+
+
+def floor_height(target: Skeleton, tmap: BoneMap) -> float:
+    """The floor the target's rest pose stands on: z = 0 when its feet are above it by less
+    than a foot's height (every Avatar rig), else its lowest foot joint."""
+    feet = [tmap.bones[r] for r in FOOT_ROLES if r in tmap.bones]
+    if not feet:
+        return 0.0
+    low = float(np.concatenate([target.heads[feet, 2], target.tails[feet, 2]]).min())
+    return 0.0 if 0.0 <= low < 0.15 else low
+
+
+def soles(target: Skeleton, tmap: BoneMap) -> tuple[np.ndarray, np.ndarray]:
+    """Points on the floor under the target's feet in its rest pose: heel, ball and its
+    two sides (carried by the foot bone) and under every toe's tip (by that toe's last
+    bone). Returns (P,) bone indices and (P, 3) rest positions (metres)."""
+    floor = floor_height(target, tmap)
+    bones, points = [], []
+    for side in ("L", "R"):
+        foot, toe = tmap.bones.get(f"foot.{side}"), tmap.bones.get(f"toe.{side}")
+        if foot is None:
+            continue
+        ankle = target.heads[foot]
+        ball = target.heads[toe] if toe is not None else target.tails[foot]
+        ahead = (ball - ankle) * (1.0, 1.0, 0.0)
+        reach = float(np.linalg.norm(ahead))
+        if reach < 1e-6:
+            continue
+        ahead /= reach
+        across = np.cross(ahead, (0.0, 0.0, 1.0)) * _HALF_WIDTH * reach
+        heel = ankle - ahead * _HEEL_BACK * max(ankle[2] - floor, 0.0)
+        tips = _leaves(target, foot)
+        for j, p in [(foot, heel), (foot, ball), (foot, ball + across), (foot, ball - across),
+                     *((t, target.tails[t]) for t in tips)]:  # fmt: skip
+            bones.append(j)
+            points.append((p[0], p[1], floor))
+    return np.array(bones, dtype=int), np.array(points, dtype=float).reshape(-1, 3)
+
+
+def _leaves(skeleton: Skeleton, bone: int) -> list[int]:
+    """The bones at the ends of the branches below ``bone`` (itself when it has none)."""
+    below = np.zeros(len(skeleton.names), dtype=bool)
+    below[bone] = True
+    for j, p in enumerate(skeleton.parents):  # parents precede children
+        if p >= 0 and below[p]:
+            below[j] = True
+    has_child = np.zeros_like(below)
+    has_child[skeleton.parents[below & (skeleton.parents >= 0)]] = True
+    return [int(j) for j in np.flatnonzero(below & ~has_child)]
+
+
+def lift(target: Skeleton, tmap: BoneMap, world: np.ndarray, root: np.ndarray) -> np.ndarray:
+    """(T,) how far (metres, >= 0) each frame must rise so that no sole point (``soles``)
+    is under the floor; world (J, T, 4) target world rotations (bones not evaluated: NaN
+    in frame 0; they keep their rest pose relative to their parent), root (T, 3) hips heads."""
+    bones, points = soles(target, tmap)
+    if not len(bones):
+        return np.zeros(len(root))
+    for k, j in enumerate(bones):  # a point on a bone that only follows its parent
+        while np.isnan(world[j, 0, 0]) and target.parents[j] >= 0:
+            j = target.parents[j]
+        bones[k] = j
+    hips = tmap.bones["hips"]
+    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, bones))
+    rest = quaternion.from_matrix(target.rest[bones, :3, :3])
+    turn = quaternion.multiply(world[bones], quaternion.conjugate(rest)[:, None])
+    z = pos[bones, :, 2] + quaternion.rotate(turn, (points - target.heads[bones])[:, None])[..., 2]
+    return np.maximum(floor_height(target, tmap) - z.min(axis=0), 0.0)

@@ -8,9 +8,12 @@ Steps (``retarget``):
 5. transfer: mapped bones take the source's world rotation, turned per frame onto the
    source segment's direction; unmapped bones follow their parent; spine and neck chains
    of different lengths share the bend;
-6. root path: the hips follow the source's, scaled by leg length, standing on the floor;
-7. feet: contacts detected on the source stay planted on the target (two-bone leg IK);
-8. world rotations -> pose-bone rotations/locations; quality metrics for the report.
+6. root path: the pelvis (between the hip joints) follows the source's, scaled by leg
+   length, with ankle level on the floor mapped onto ankle level; the hips hang from it;
+7. feet: contacts detected on the source stay planted on the target (two-bone leg IK),
+   and frames that would put a sole under the floor rise onto it (``contacts.lift``);
+8. world rotations -> pose-bone rotations/locations; quality metrics for the report;
+9. onto a ``Human``: the motion settled on its skin (``floor.settle``), the final polish.
 
 Per-frame arrays are quaternions and 3-vectors with the bone axis first, (J, T, 4) and
 (J, T, 3), in float32 (see docs/benchmarks.md "Motion" for why); only bones that carry
@@ -20,15 +23,19 @@ driven bones or segment ends are evaluated.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from avatar.motion import bonemap, calibrate, contacts, geometry, metrics, timing
+from avatar.motion import bonemap, calibrate, contacts, floor, geometry, metrics, timing
 from avatar.motion.pairs import Pair, make_pairs, segment_rest, segments
 from avatar.rig import quaternion
 from avatar.rig.kinematics import levels, rest_quaternions, world_pose
 from avatar.rig.skeleton import Animation, Skeleton
+
+if TYPE_CHECKING:
+    from avatar.human import Human
 
 
 @dataclass(frozen=True)
@@ -45,6 +52,7 @@ class RetargetReport:
     fps: float
     quality: metrics.Quality | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    floor: floor.FloorReport | None = None  # onto a Human: its skin on the floor, settled
 
     def summary(self) -> str:
         """A few human-readable lines for logs and the CLI."""
@@ -54,6 +62,8 @@ class RetargetReport:
         ]
         if self.quality is not None:
             lines.append(self.quality.summary())
+        if self.floor is not None:
+            lines.append(self.floor.summary())
         lines.extend(self.notes)
         return "\n".join(lines)
 
@@ -86,7 +96,7 @@ class _Source:
 def retarget(
     source_skeleton: Skeleton,
     source_animation: Animation,
-    target_skeleton: Skeleton,
+    target_skeleton: Skeleton | Human,
     *,
     source_map: str | os.PathLike[str] = "auto",
     target_map: str | os.PathLike[str] = "auto",
@@ -100,7 +110,10 @@ def retarget(
     """Transfer ``source_animation`` onto ``target_skeleton``.
 
     source_skeleton/source_animation: the clip (e.g. from ``avatar.motion.load_bvh``).
-    target_skeleton: any rig (``Human(...).skeleton``), metres, Z-up, facing -Y.
+    target_skeleton: any rig (``Human(...).skeleton``), metres, Z-up, facing -Y, its rest
+        pose standing on the floor (z = 0 for Avatar rigs); or a ``Human``: its rig, and
+        the result then settled on its skin (``floor.settle_human``: planted feet touch
+        the floor, no vertex under it; ``RetargetReport.floor`` says how it meets it).
     source_map/target_map: convention name, bone map JSON path, or "auto".
     frames: source frames to keep (slice, applied before resampling); fps: output rate.
     in_place: remove horizontal root motion. fix_feet: keep contacts planted (leg IK).
@@ -108,6 +121,9 @@ def retarget(
     measure: compute ``RetargetReport.quality`` (cheap; off for the fastest batch runs).
     Returns the target ``Animation`` (T, J_target) and a ``RetargetReport``.
     """
+    human = None
+    if not isinstance(target_skeleton, Skeleton):
+        human, target_skeleton = target_skeleton, target_skeleton.skeleton
     anim = timing.resample(timing.select(source_animation, frames), fps)
     src = _Source(source_skeleton, *world_pose(source_skeleton, anim.rotations, anim.translations,
                                                bones_first=True, dtype=_WORK_TYPE))  # fmt: skip
@@ -120,13 +136,14 @@ def retarget(
     world, rigid = _transfer(pairs, align, src, src_seg, target_skeleton)
     scale = _leg_length(target_skeleton, tmap) / _leg_length(source_skeleton, smap)
     hips = tmap.bones["hips"]
-    root = _root_path(src, smap, tmap, target_skeleton, scale, in_place)
+    root = _root_path(src, smap, tmap, target_skeleton, world, scale, in_place)
     feet = None
     if fix_feet or measure:
         leg = _leg_length(source_skeleton, smap)
         feet = contacts.detect(src.pos.swapaxes(0, 1), smap, anim.fps, leg)
     if feet is not None and fix_feet:
         world = contacts.plant(feet, tmap, target_skeleton, world, root, anim.fps)
+        root[:, 2] += contacts.lift(target_skeleton, tmap, world, root)
     out = _to_local(target_skeleton, world, rigid, hips, root, anim.fps)
     quality = None
     if measure:
@@ -136,7 +153,16 @@ def retarget(
         framewise = (world.swapaxes(0, 1), pos.swapaxes(0, 1))  # metrics take (T, J, ...)
         quality = metrics.measure(pairs, src.frames_first(), target_skeleton, *framewise, tmap,
                                   feet, anim.fps)  # fmt: skip
-    return out, _report(pairs, smap, tmap, source_skeleton, target_skeleton, scale, out, quality)
+    report = _report(pairs, smap, tmap, source_skeleton, target_skeleton, scale, out, quality)
+    return (out, report) if human is None else _settle(human, out, report)
+
+
+def _settle(human: Human, animation: Animation, report: RetargetReport):
+    """The animation settled on the human's skin (planted feet on the floor, no vertex
+    under it: ``floor.settle_human``) and the report with how it meets the floor now."""
+    ground = floor.measure_human(human, animation)
+    animation, shift = floor.settle_human(human, animation, report=ground)
+    return animation, replace(report, floor=ground.shifted(shift))
 
 
 def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.ndarray,
@@ -315,18 +341,43 @@ def _leg_length(skeleton: Skeleton, bmap: bonemap.BoneMap) -> float:
     return float(np.ptp(skeleton.heads[:, 2])) / 2 or 1.0
 
 
-def _root_path(src: _Source, smap, tmap, target: Skeleton, scale: float, in_place: bool):
-    """(T, 3) target hips positions: the source's scaled, with foot level mapped to foot
-    level (each skeleton's lowest foot joint in contact lands on the other's)."""
-    hips_s = src.pos[smap.bones["hips"]]
-    floor_s = contacts.foot_level(src.pos.swapaxes(0, 1), smap)
-    feet_t = [tmap.bones[b] for b in contacts.FOOT_ROLES if b in tmap.bones]
-    floor_t = float(target.heads[feet_t, 2].min()) if feet_t else 0.0
-    out = hips_s * scale
-    out[:, 2] = floor_t + scale * (hips_s[:, 2] - floor_s)
+def _root_path(src: _Source, smap: bonemap.BoneMap, tmap: bonemap.BoneMap, target: Skeleton,
+               world: np.ndarray, scale: float, in_place: bool) -> np.ndarray:  # fmt: skip
+    """(T, 3) target hips heads: the source's pelvis scaled by leg length, its height above
+    the source's ankles on the floor mapped to the target's above its rest ankles; the hips
+    then placed from the target's pelvis, turned by the target's world rotations (J, T, 4).
+
+    The pelvis is the midpoint of the hip (thigh) joints, not the hips joint: that sits
+    level with them on MakeHuman rigs but 2-10 cm above them on CMU and Reallusion ones.
+    Ankles, not the lowest foot joint: the legs scale from hip joint to ankle, and the
+    ankle is at the same place on every rig (a toe joint is at the ball or the tip), so a
+    frame standing on flat feet stands the target's ankles at their rest height, its soles
+    on the floor they stand on in the rest pose.
+    """
+    pelvis = _pelvis(src.pos, smap) * scale
+    ankles_s = contacts.foot_level(src.pos.swapaxes(0, 1), smap, ("foot.L", "foot.R"))
+    ankles_t = [tmap.bones[r] for r in ("foot.L", "foot.R") if r in tmap.bones]
+    rest_t = float(target.heads[ankles_t, 2].mean()) if ankles_t else 0.0
+    pelvis[:, 2] += rest_t - scale * ankles_s
+    hips = tmap.bones["hips"]
+    legs = [tmap.bones[r] for r in ("thigh.L", "thigh.R") if r in tmap.bones]
+    out = pelvis
+    if legs and all(geometry.path(target, hips, j) for j in legs):  # thighs hang from hips
+        zero = np.zeros((world.shape[1], 3))
+        pos = geometry.positions(target, world, {hips: zero}, geometry.ancestors(target, legs))
+        out = pelvis - _pelvis(pos, tmap)  # the target's pelvis relative to its hips head
     if in_place:
-        out[:, :2] = target.heads[tmap.bones["hips"], :2]
+        out[:, :2] = target.heads[hips, :2]
     return out
+
+
+def _pelvis(pos: np.ndarray, bmap: bonemap.BoneMap) -> np.ndarray:
+    """(T, 3) float64 midpoint of the hip joints (thigh heads) from heads (J, T, 3); the
+    hips head when a thigh is not mapped."""
+    legs = [bmap.bones[r] for r in ("thigh.L", "thigh.R") if r in bmap.bones]
+    if len(legs) < 2:
+        return pos[bmap.bones["hips"]].astype(np.float64)
+    return (pos[legs[0]].astype(np.float64) + pos[legs[1]]) / 2
 
 
 def _to_local(target: Skeleton, world: np.ndarray, rigid: np.ndarray, hips: int,
