@@ -77,7 +77,8 @@ def test_motion_is_applied_and_survives_update(empty_scene, fake_library, monkey
 
     def retarget(source, clip, target, frames, fps, in_place):
         calls.append((clip, frames, fps, in_place))
-        return random_animation(target, np.random.default_rng(2), frames=6), None
+        # the Motion panel retargets onto the Human (its skin settles the feet on the floor)
+        return random_animation(target.skeleton, np.random.default_rng(2), frames=6), None
 
     monkeypatch.setattr(avatar.motion, "load_bvh", lambda path: (None, path))
     monkeypatch.setattr(avatar.motion, "retarget", retarget)

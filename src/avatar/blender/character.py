@@ -59,7 +59,7 @@ def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.Charact
     name, location = root.name, tuple(root.location)
     collection = root.users_collection[0] if root.users_collection else None
     motion = json.loads(root[MOTION_KEY]) if MOTION_KEY in root.keys() else None
-    animation = load_motion(motion, human.skeleton) if motion else None
+    animation = load_motion(motion, human) if motion else None
     remove(root, drop_collection=False)
     character = stage.character_from_human(human, name=name, location=location)
     if character.recipe is None:
@@ -90,14 +90,15 @@ def apply_motion(obj: bpy.types.Object, motion: Mapping[str, object]) -> str:
         from avatar.errors import AvatarError
 
         raise AvatarError("select a rigged Avatar character first")
-    animation = load_motion(motion, realise(recipe_of(root)).skeleton)
+    animation = load_motion(motion, realise(recipe_of(root)))
     action_bridge.apply_animation(root, animation, f"{root.name} motion")
     root[MOTION_KEY] = json.dumps(dict(motion))
     return f"{root.name}: {animation.frames} frames at {animation.fps:g} fps"
 
 
-def load_motion(motion: Mapping[str, object], skeleton) -> object:
-    """The Animation of a Motion-panel spec, retargeted onto ``skeleton``.
+def load_motion(motion: Mapping[str, object], human) -> object:
+    """The Animation of a Motion-panel spec, retargeted onto ``human`` (an
+    ``avatar.human.Human``) and settled on its skin: planted feet on the floor.
 
     motion["frames"]: [start, stop] source frames as the CLI's ``--frames A:B`` (0-based,
     stop exclusive, None = to the end), or None for the whole clip.
@@ -109,7 +110,7 @@ def load_motion(motion: Mapping[str, object], skeleton) -> object:
     animation, _report = library.retarget(
         source_skeleton,
         clip,
-        skeleton,
+        human,
         frames=slice(*frames) if frames else None,
         fps=motion.get("fps"),
         in_place=bool(motion.get("in_place")),
