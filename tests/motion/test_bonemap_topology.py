@@ -221,3 +221,17 @@ def test_random_trees_never_break_it():
             assert "hips" in bonemap.detect(skeleton).bones
         except ParameterError:
             pass
+
+
+def test_conventions_are_read_once_and_handed_out_as_copies():
+    """``detect`` reuses the parsed convention files; ``conventions()`` hands out fresh
+    copies, so changing one changes neither later calls nor detection."""
+    skeleton = _stick_figure()
+    before = bonemap.detect(skeleton)
+    table = bonemap.conventions()
+    table["cmu_motionbuilder"]["hips"] = ["bone0"]
+    table.clear()
+    assert "cmu_motionbuilder" in bonemap.conventions()
+    assert bonemap.conventions()["cmu_motionbuilder"]["hips"] != ["bone0"]
+    assert bonemap.detect(skeleton) == before
+    assert bonemap._shipped() is bonemap._shipped()  # parsed once per process

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -95,3 +97,66 @@ def test_settle_puts_planted_feet_on_the_floor(human):
     np.testing.assert_allclose(b[..., :2], a[..., :2], atol=1e-6)
     np.testing.assert_allclose(b[..., 2] - a[..., 2], np.broadcast_to(shift[:, None], b.shape[:2]),
                                atol=1e-6)  # fmt: skip
+
+
+FIXTURES = Path(__file__).resolve().parents[2] / ".." / "shared" / "fixtures" / "bvh"
+CLIPS = sorted(p for p in FIXTURES.glob("*/*.bvh") if "face" not in p.name)
+
+
+@pytest.mark.skipif(not CLIPS, reason="../shared/fixtures/bvh is absent")
+@pytest.mark.parametrize("clip", CLIPS, ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_retargeted_clips_stand_on_the_floor_before_settling(human, clip):
+    """The retargeter's own output (no mesh, no settle): planted feet within 1 cm of the
+    floor (median), no skin vertex more than 1 cm under it."""
+    from avatar.io import bvh
+    from avatar.motion.retarget import retarget
+
+    source, clip_animation = bvh.load(clip)
+    out, _ = retarget(source, clip_animation, human.skeleton, measure=False)
+    report = floor.measure_human(human, out, most_frames=150)
+    assert report.hover_cm < 1.0 and report.penetration_cm < 1.0, report.summary()
+
+
+@pytest.mark.skipif(not CLIPS, reason="../shared/fixtures/bvh is absent")
+def test_retarget_onto_a_human_settles_on_its_skin(human):
+    from avatar.io import bvh
+    from avatar.motion.retarget import retarget
+
+    source, clip_animation = bvh.load(FIXTURES / "cmu_motionbuilder" / "02_01_walk.bvh")
+    out, report = retarget(source, clip_animation, human)
+    assert report.floor is not None and "mesh on floor" in report.summary()
+    assert report.floor.penetration_cm < 0.1 and report.floor.hover_cm < 0.1
+    bare, plain = retarget(source, clip_animation, human.skeleton)
+    assert plain.floor is None
+    settled, _ = floor.settle_human(human, bare)
+    np.testing.assert_allclose(out.translations, settled.translations, atol=1e-9)
+    np.testing.assert_allclose(out.rotations, bare.rotations)
+
+
+def test_sole_points_lie_on_the_floor_under_the_feet(human):
+    from avatar.motion import bonemap, contacts
+
+    skeleton = human.skeleton
+    tmap = bonemap.detect(skeleton)
+    bones, points = contacts.soles(skeleton, tmap)
+    assert contacts.floor_height(skeleton, tmap) == 0.0
+    assert len(bones) >= 10 and np.all(points[:, 2] == 0.0)
+    # Under the feet: each point within a foot's length of its side's ankle.
+    for side, sign in (("L", 1), ("R", -1)):
+        ankle = skeleton.heads[tmap.bones[f"foot.{side}"]]
+        mine = points[np.sign(points[:, 0]) == sign]
+        assert len(mine) == len(points) // 2
+        assert np.linalg.norm(mine[:, :2] - ankle[:2], axis=1).max() < 0.25
+    # The rest pose needs no lift; the same pose sunk 3 cm rises 3 cm.
+    rest = np.tile(_rest_rotations(skeleton)[:, None], (1, 2, 1))
+    root = np.tile(skeleton.heads[tmap.bones["hips"]], (2, 1))
+    root[1, 2] -= 0.03
+    up = contacts.lift(skeleton, tmap, rest, root)
+    np.testing.assert_allclose(up, [0.0, 0.03], atol=1e-6)
+
+
+def _rest_rotations(skeleton) -> np.ndarray:
+    """(J, 4) rest world rotations of every bone."""
+    from avatar.rig.kinematics import rest_quaternions
+
+    return rest_quaternions(skeleton)[0]
