@@ -250,9 +250,18 @@ def lift(target: Skeleton, tmap: BoneMap, world: np.ndarray, root: np.ndarray) -
         while np.isnan(world[j, 0, 0]) and target.parents[j] >= 0:
             j = target.parents[j]
         bones[k] = j
+    carriers, which = np.unique(bones, return_inverse=True)
     hips = tmap.bones["hips"]
-    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, bones))
-    rest = quaternion.from_matrix(target.rest[bones, :3, :3])
-    turn = quaternion.multiply(world[bones], quaternion.conjugate(rest)[:, None])
-    z = pos[bones, :, 2] + quaternion.rotate(turn, (points - target.heads[bones])[:, None])[..., 2]
-    return np.maximum(floor_height(target, tmap) - z.min(axis=0), 0.0)
+    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, carriers))
+    rest = quaternion.from_matrix(target.rest[carriers, :3, :3])
+    w, x, y, z = np.moveaxis(
+        quaternion.multiply(world[carriers], quaternion.conjugate(rest)[:, None]), -1, 0
+    )
+    # Only heights matter: the third row of each carrier's turn (as a matrix), (C, T, 3).
+    up = np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1)
+    lowest = np.full(len(root), np.inf)
+    for c in range(len(carriers)):
+        offsets = points[which == c] - target.heads[carriers[c]]  # (P_c, 3)
+        heights = pos[carriers[c], :, 2, None] + up[c] @ offsets.T  # (T, P_c)
+        lowest = np.minimum(lowest, heights.min(axis=1))
+    return np.maximum(floor_height(target, tmap) - lowest, 0.0)
