@@ -250,6 +250,10 @@ def lift(target: Skeleton, tmap: BoneMap, world: np.ndarray, root: np.ndarray) -
         while np.isnan(world[j, 0, 0]) and target.parents[j] >= 0:
             j = target.parents[j]
         bones[k] = j
+    known = ~np.isnan(world[bones, 0, 0])  # a root left unevaluated carries nothing
+    bones, points = bones[known], points[known]
+    if not len(bones):
+        return np.zeros(len(root))
     carriers, which = np.unique(bones, return_inverse=True)
     hips = tmap.bones["hips"]
     pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, carriers))
