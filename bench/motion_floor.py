@@ -4,8 +4,9 @@
 
 Per clip (onto the default Avatar body and rig): the lowest skin vertex per frame against
 the floor z = 0 (``avatar.motion.floor``), on at most N evenly spaced frames (default 3000),
-as retargeted and after ``floor.settle`` (vertical shifts, frame by frame, putting planted
-feet on the floor), and the time one measurement took. Prints a table for docs/benchmarks.md.
+as retargeted (the retargeter alone, no mesh) and after ``floor.settle`` (vertical shifts,
+frame by frame, putting planted feet on the floor), and the time one measurement took.
+Prints a table for docs/benchmarks.md.
 Also retargets each clip with its joints renamed ``j0..jN`` (bone map by topology) and
 reports the largest change of a body segment's direction against the name-based result.
 """
@@ -42,9 +43,9 @@ def main(argv: list[str]) -> None:
     tmap = bonemap.detect(target)
     segs = np.array([(tmap.bones[r], tmap.bones[n]) for r, n in bonemap.NEXT.items()
                      if r in bonemap.CORE and n in bonemap.CORE])  # fmt: skip
-    print("| clip | frames | skinned | as retargeted: penetration / hover cm | settle shift cm "
-          "| penetration cm | frames penetrating | hover cm median / max | contact frames "
-          "| measure s | renamed: max deg |")  # fmt: skip
+    print("| clip | frames | skinned | as retargeted: penetration cm (frames) | hover cm median "
+          "/ max | contact frames | settle shift cm | settled: penetration cm | hover cm median "
+          "/ max | measure s | renamed: max deg |")  # fmt: skip
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for clip in sorted(FIXTURES.glob("*/*.bvh")):
         if "face" in clip.name:
@@ -64,10 +65,10 @@ def main(argv: list[str]) -> None:
         err = geometry.angle(_segments(target, a, segs), _segments(target, b, segs)).max()
         print(
             f"| {clip.parent.name}/{clip.name} | {rep.total_frames} | {rep.frames} | "
-            f"{before.penetration_cm:.1f} / {before.hover_cm:.1f} | {np.median(shift) * 100:+.1f} "
-            f"({shift.min() * 100:+.1f}..{shift.max() * 100:+.1f}) | "
-            f"{rep.penetration_cm:.1f} | {rep.penetrating * 100:.1f}% | "
-            f"{rep.hover_cm:.1f} / {rep.hover_max_cm:.1f} | {rep.contact_frames} | "
+            f"{before.penetration_cm:.1f} ({before.penetrating * 100:.1f}%) | "
+            f"{before.hover_cm:.1f} / {before.hover_max_cm:.1f} | {before.contact_frames} | "
+            f"{np.median(shift) * 100:+.1f} ({shift.min() * 100:+.1f}..{shift.max() * 100:+.1f}) | "
+            f"{rep.penetration_cm:.1f} | {rep.hover_cm:.1f} / {rep.hover_max_cm:.1f} | "
             f"{seconds:.2f} | {err:.3f} |"
         )
 
