@@ -2,7 +2,8 @@
 quality metrics).
 
     skeleton, clip = load_bvh("walk.bvh")
-    animation, report = retarget(skeleton, clip, Human().skeleton)
+    animation, report = retarget(skeleton, clip, Human().skeleton)  # onto the rig
+    animation, report = retarget(skeleton, clip, Human())  # and settled on its skin
     print(report.summary())
 """
 
