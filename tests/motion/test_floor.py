@@ -113,7 +113,7 @@ def test_retargeted_clips_stand_on_the_floor_before_settling(human, clip):
 
     source, clip_animation = bvh.load(clip)
     out, _ = retarget(source, clip_animation, human.skeleton, measure=False)
-    report = floor.measure_human(human, out, most_frames=150)
+    report = floor.measure_human(human, out, most_frames=600)
     assert report.hover_cm < 1.0 and report.penetration_cm < 1.0, report.summary()
 
 
@@ -140,7 +140,10 @@ def test_sole_points_lie_on_the_floor_under_the_feet(human):
     tmap = bonemap.detect(skeleton)
     bones, points = contacts.soles(skeleton, tmap)
     assert contacts.floor_height(skeleton, tmap) == 0.0
-    assert len(bones) >= 10 and np.all(points[:, 2] == 0.0)
+    assert len(bones) >= 10 and np.all(points[:, 2] >= 0.0)
+    tips = points[:, 2] > 0.0  # half way down from the toe tips; the rest on the floor
+    assert 0 < tips.sum() < len(points)
+    np.testing.assert_allclose(points[tips, 2], skeleton.tails[bones[tips], 2] / 2)
     # Under the feet: each point within a foot's length of its side's ankle.
     for side, sign in (("L", 1), ("R", -1)):
         ankle = skeleton.heads[tmap.bones[f"foot.{side}"]]
@@ -151,7 +154,7 @@ def test_sole_points_lie_on_the_floor_under_the_feet(human):
     rest = np.tile(_rest_rotations(skeleton)[:, None], (1, 2, 1))
     root = np.tile(skeleton.heads[tmap.bones["hips"]], (2, 1))
     root[1, 2] -= 0.03
-    up = contacts.lift(skeleton, tmap, rest, root)
+    up = contacts.lift(skeleton, tmap, rest, root, fps=1.0)  # 0.1 s: no easing
     np.testing.assert_allclose(up, [0.0, 0.03], atol=1e-6)
 
 

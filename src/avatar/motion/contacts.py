@@ -24,6 +24,7 @@ _SPEED = 0.15  # leg lengths per second
 _NEAR_FLOOR = 0.06  # leg lengths: a contact this close to the floor is put on it
 _MIN_CONTACT_S = 0.05
 _BLEND_S = 0.1
+_EASE_S = 0.05  # a floor lift eases in and out over twice this
 _STRAIGHT = np.sin(np.radians(0.1))  # knee bends below this have no plane of their own
 _BACK = np.array([0.0, 1.0, 0.0])  # Avatar characters face -Y: knees bend toward +Y
 
@@ -95,24 +96,43 @@ def plant(feet: FootContacts, tmap: BoneMap, target: Skeleton, world: np.ndarray
     hips = tmap.bones["hips"]
     legs = [tmap.bones[f"{r}.{s}"] for r in ("thigh", "shin", "foot", "toe") for s in "LR"
             if f"{r}.{s}" in tmap.bones]  # fmt: skip
-    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, legs))
+    on_soles = {side: _carried(target, world, *soles(target, tmap, (side,))) for side in "LR"}
+    carriers = [j for bones, _ in on_soles.values() for j in bones]
+    pos = geometry.positions(target, world, {hips: root},
+                             geometry.ancestors(target, [*legs, *carriers]))  # fmt: skip
     for side in ("L", "R"):
         roles = [f"{r}.{side}" for r in ("thigh", "shin", "foot")]
         if any(r not in tmap.bones for r in roles):
             continue
-        goal = _ankle_goals(feet.pinned[side], pos, tmap, side, target, fps)
+        sole = _lowest(target, world, pos, *on_soles[side])
+        other = feet.frames("R" if side == "L" else "L")
+        goal = _ankle_goals(feet.pinned[side], other, pos, sole, tmap, side, target, fps)
         if goal is not None:
             thigh, shin, foot = (tmap.bones[r] for r in roles)
             _two_bone_ik(world, pos, target, thigh, shin, foot, goal)
     return world
 
 
-def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: float):
-    """(T, 3) where the ankle should be, blended around contacts; pos (J, T, 3)."""
+def _ankle_goals(pinned, other, pos, sole, tmap: BoneMap, side: str, target: Skeleton,
+                 fps: float):  # fmt: skip
+    """(T, 3) where the ankle should be, blended around contacts; pos (J, T, 3), sole (T,)
+    the foot's lowest sole point's height (``soles``) as retargeted, other (T,) bool: the
+    other foot is in contact.
+
+    A pinned joint stays at its mean position over the contact; near the floor, its
+    height is instead whatever puts the lowest sole point on the floor that frame: the
+    source's foot may meet the floor at another angle than the target's rest foot (CMU's
+    flat foot has its toe joint 1 cm under the ankle, MakeHuman's 4 cm), so the joint's
+    rest height would sink a heel or lift a toe. A free foot whose sole would be under the
+    floor while the other is planted is raised by as much (eased in and out over 0.1 s);
+    with no foot planted, ``lift`` raises the body instead (a nearly straight leg bends
+    several degrees to shorten by millimetres).
+    """
     ankle = tmap.bones[f"foot.{side}"]
     offset = np.zeros((len(pinned), 3))
     weight = np.zeros(len(pinned))
     near_floor = _NEAR_FLOOR * _leg(target, tmap, side)
+    floor = floor_height(target, tmap)
     for role in ("foot", "toe"):
         j = tmap.bones.get(f"{role}.{side}")
         if j is None:
@@ -124,14 +144,21 @@ def _ankle_goals(pinned, pos, tmap: BoneMap, side: str, target: Skeleton, fps: f
         # each run's mean position, from running sums (all runs at once)
         total = np.concatenate([np.zeros((1, 3)), np.cumsum(pos[j], axis=0, dtype=np.float64)])
         pin = (total[runs[:, 1]] - total[runs[:, 0]]) / (runs[:, 1] - runs[:, 0])[:, None]
-        rest_z = target.heads[j, 2]
-        pin[:, 2] = np.where(pin[:, 2] - rest_z < near_floor, rest_z, pin[:, 2])  # on the floor
+        on_floor = np.repeat(pin[:, 2] - target.heads[j, 2] < near_floor, runs[:, 1] - runs[:, 0])
         offset[down] = np.repeat(pin, runs[:, 1] - runs[:, 0], axis=0) - pos[j, down]
+        offset[down, 2] = np.where(on_floor, floor - sole[down], offset[down, 2])
         weight[down] = 1.0
-    if not weight.any():
+    if weight.any():
+        offset, weight = _blend(offset, weight, max(1, int(round(_BLEND_S * fps))))
+    shift = offset * weight[:, None]
+    # A free foot whose sole would go under the floor (a toe tip pointed down further
+    # than the source's) is raised by its own leg, not by lifting the whole body off the
+    # planted one.
+    under = np.maximum(floor - (sole + shift[:, 2]), 0.0) * (other & (weight == 0))
+    if not under.any() and not weight.any():
         return None
-    offset, weight = _blend(offset, weight, max(1, int(round(_BLEND_S * fps))))
-    return pos[ankle] + offset * weight[:, None]
+    shift[:, 2] += _envelope(under, max(1, int(round(_EASE_S * fps))))
+    return pos[ankle] + shift
 
 
 def _blend(offset: np.ndarray, weight: np.ndarray, n: int):
@@ -188,6 +215,7 @@ def _two_bone_ik(world, pos, target: Skeleton, thigh: int, shin: int, foot: int,
 # ankle), and to each side of the ball by this fraction of the ankle-to-ball distance.
 _HEEL_BACK = 0.6
 _HALF_WIDTH = 0.3
+_TIP_FLESH = 0.5  # of a toe tip's height: MakeHuman's skin there is 0.7 cm up, tails 1.4 cm
 
 
 def floor_height(target: Skeleton, tmap: BoneMap) -> float:
@@ -200,13 +228,15 @@ def floor_height(target: Skeleton, tmap: BoneMap) -> float:
     return 0.0 if 0.0 <= low < 0.15 else low
 
 
-def soles(target: Skeleton, tmap: BoneMap) -> tuple[np.ndarray, np.ndarray]:
-    """Points on the floor under the target's feet in its rest pose: heel, ball and its
-    two sides (carried by the foot bone) and under every toe's tip (by that toe's last
-    bone). Returns (P,) bone indices and (P, 3) rest positions (metres)."""
+def soles(target: Skeleton, tmap: BoneMap,
+          sides: tuple[str, ...] = ("L", "R")) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Points under the target's feet in its rest pose: on the floor under the heel, the
+    ball and its two sides (carried by the foot bone), and half way down from every toe's
+    tip (carried by that toe's last bone). Returns (P,) bone indices and (P, 3) rest
+    positions (metres)."""
     floor = floor_height(target, tmap)
     bones, points = [], []
-    for side in ("L", "R"):
+    for side in sides:
         foot, toe = tmap.bones.get(f"foot.{side}"), tmap.bones.get(f"toe.{side}")
         if foot is None:
             continue
@@ -219,11 +249,13 @@ def soles(target: Skeleton, tmap: BoneMap) -> tuple[np.ndarray, np.ndarray]:
         ahead /= reach
         across = np.cross(ahead, (0.0, 0.0, 1.0)) * _HALF_WIDTH * reach
         heel = ankle - ahead * _HEEL_BACK * max(ankle[2] - floor, 0.0)
-        tips = _leaves(target, foot)
-        for j, p in [(foot, heel), (foot, ball), (foot, ball + across), (foot, ball - across),
-                     *((t, target.tails[t]) for t in tips)]:  # fmt: skip
+        for j, p in [(foot, heel), (foot, ball), (foot, ball + across), (foot, ball - across)]:
             bones.append(j)
             points.append((p[0], p[1], floor))
+        for j in _leaves(target, foot):  # toe tips curl up: the flesh is half way down
+            tail = target.tails[j]
+            bones.append(j)
+            points.append((tail[0], tail[1], floor + max(tail[2] - floor, 0.0) * _TIP_FLESH))
     return np.array(bones, dtype=int), np.array(points, dtype=float).reshape(-1, 3)
 
 
@@ -239,33 +271,60 @@ def _leaves(skeleton: Skeleton, bone: int) -> list[int]:
     return [int(j) for j in np.flatnonzero(below & ~has_child)]
 
 
-def lift(target: Skeleton, tmap: BoneMap, world: np.ndarray, root: np.ndarray) -> np.ndarray:
+def lift(target: Skeleton, tmap: BoneMap, world: np.ndarray, root: np.ndarray,
+         fps: float) -> np.ndarray:  # fmt: skip
     """(T,) how far (metres, >= 0) each frame must rise so that no sole point (``soles``)
-    is under the floor; world (J, T, 4) target world rotations (bones not evaluated: NaN
-    in frame 0; they keep their rest pose relative to their parent), root (T, 3) hips heads."""
-    bones, points = soles(target, tmap)
-    if not len(bones):
-        return np.zeros(len(root))
-    for k, j in enumerate(bones):  # a point on a bone that only follows its parent
+    is under the floor, eased in and out over 0.1 s; world (J, T, 4) target world rotations
+    (bones not evaluated: NaN in frame 0), root (T, 3) hips heads."""
+    hips = tmap.bones["hips"]
+    bones, points = _carried(target, world, *soles(target, tmap))
+    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, bones))
+    need = floor_height(target, tmap) - _lowest(target, world, pos, bones, points)
+    return _envelope(np.maximum(need, 0.0), max(1, int(round(_EASE_S * fps))))
+
+
+def _envelope(x: np.ndarray, width: int) -> np.ndarray:
+    """A smooth curve never below ``x`` (T,): the largest value within ``width`` frames,
+    averaged over ``width`` frames (a lift that comes and goes in one frame would pop)."""
+    if len(x) < 2 or width < 2:
+        return x
+    pad = np.pad(x, width, mode="edge")
+    peak = np.lib.stride_tricks.sliding_window_view(pad, 2 * width + 1).max(axis=1)
+    kernel = np.ones(2 * width + 1) / (2 * width + 1)
+    return np.convolve(np.pad(peak, width, mode="edge"), kernel, mode="valid")
+
+
+def _carried(target: Skeleton, world: np.ndarray, bones: np.ndarray,
+             points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Sole points (P, 3) on ``bones`` (P,) re-assigned to the bones that move them: a
+    bone not evaluated (world NaN in frame 0) keeps its rest pose relative to its parent,
+    so its points go with the nearest evaluated ancestor; points with none are dropped."""
+    bones = bones.copy()
+    for k, j in enumerate(bones):
         while np.isnan(world[j, 0, 0]) and target.parents[j] >= 0:
             j = target.parents[j]
         bones[k] = j
-    known = ~np.isnan(world[bones, 0, 0])  # a root left unevaluated carries nothing
-    bones, points = bones[known], points[known]
+    known = ~np.isnan(world[bones, 0, 0])
+    return bones[known], points[known]
+
+
+def _lowest(target: Skeleton, world: np.ndarray, pos: np.ndarray, bones: np.ndarray,
+            points: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(T,) height of the lowest of ``points`` (P, 3) (rest positions) carried by evaluated
+    ``bones`` (P,) (``_carried``); world (J, T, 4) rotations, pos (J, T, 3) heads.
+    +inf: no points."""
+    lowest = np.full(world.shape[1], np.inf)
     if not len(bones):
-        return np.zeros(len(root))
+        return lowest
     carriers, which = np.unique(bones, return_inverse=True)
-    hips = tmap.bones["hips"]
-    pos = geometry.positions(target, world, {hips: root}, geometry.ancestors(target, carriers))
     rest = quaternion.from_matrix(target.rest[carriers, :3, :3])
     w, x, y, z = np.moveaxis(
         quaternion.multiply(world[carriers], quaternion.conjugate(rest)[:, None]), -1, 0
     )
     # Only heights matter: the third row of each carrier's turn (as a matrix), (C, T, 3).
     up = np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1)
-    lowest = np.full(len(root), np.inf)
     for c in range(len(carriers)):
         offsets = points[which == c] - target.heads[carriers[c]]  # (P_c, 3)
         heights = pos[carriers[c], :, 2, None] + up[c] @ offsets.T  # (T, P_c)
         lowest = np.minimum(lowest, heights.min(axis=1))
-    return np.maximum(floor_height(target, tmap) - lowest, 0.0)
+    return lowest

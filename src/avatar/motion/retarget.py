@@ -143,7 +143,7 @@ def retarget(
         feet = contacts.detect(src.pos.swapaxes(0, 1), smap, anim.fps, leg)
     if feet is not None and fix_feet:
         world = contacts.plant(feet, tmap, target_skeleton, world, root, anim.fps)
-        root[:, 2] += contacts.lift(target_skeleton, tmap, world, root)
+        root[:, 2] += contacts.lift(target_skeleton, tmap, world, root, anim.fps)
     out = _to_local(target_skeleton, world, rigid, hips, root, anim.fps)
     quality = None
     if measure:
