@@ -4,8 +4,10 @@ A foot joint (ankle or toe) is in contact while it is nearly still (speed below 
 length per second) for at least 50 ms; floors at any height (steps, boxes) count. While the
 toe is down the toe is pinned (heel-off pivots about it), else the ankle. The target's leg
 is bent by analytic two-bone IK so the pinned joint stays at its mean position over the
-contact (on the floor when it was within a few cm of it), blending in and out over 0.1 s.
-The foot keeps its retargeted world orientation.
+contact, blending in and out over 0.1 s; a contact within a few cm of the floor is put on
+it: the foot's lowest sole point (``soles``: heel, ball, toe tips, from the rig alone) at
+the floor's height, frame by frame. The foot keeps its retargeted world orientation.
+``lift`` then raises any frame that still has a sole point under the floor.
 """
 
 from __future__ import annotations
@@ -146,6 +148,7 @@ def _ankle_goals(pinned, other, pos, sole, tmap: BoneMap, side: str, target: Ske
         pin = (total[runs[:, 1]] - total[runs[:, 0]]) / (runs[:, 1] - runs[:, 0])[:, None]
         on_floor = np.repeat(pin[:, 2] - target.heads[j, 2] < near_floor, runs[:, 1] - runs[:, 0])
         offset[down] = np.repeat(pin, runs[:, 1] - runs[:, 0], axis=0) - pos[j, down]
+        on_floor &= np.isfinite(sole[down])  # (a foot without sole points: the mean)
         offset[down, 2] = np.where(on_floor, floor - sole[down], offset[down, 2])
         weight[down] = 1.0
     if weight.any():
