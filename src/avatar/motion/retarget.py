@@ -116,7 +116,8 @@ def retarget(
         the floor, no vertex under it; ``RetargetReport.floor`` says how it meets it).
     source_map/target_map: convention name, bone map JSON path, or "auto".
     frames: source frames to keep (slice, applied before resampling); fps: output rate.
-    in_place: remove horizontal root motion. fix_feet: keep contacts planted (leg IK).
+    in_place: remove horizontal root motion. fix_feet: keep contacts planted, soles on the
+        floor and out of it (leg IK, ``contacts.plant`` and ``contacts.lift``).
     match_names: also drive target bones whose names equal a source bone's.
     measure: compute ``RetargetReport.quality`` (cheap; off for the fastest batch runs).
     Returns the target ``Animation`` (T, J_target) and a ``RetargetReport``.
