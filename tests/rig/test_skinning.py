@@ -25,6 +25,23 @@ def test_every_rig_is_placed_and_weighted(model, rig):
     assert np.all(np.diff(h.model.assets.weights(rig)[1]) >= 0)
 
 
+def test_a_rig_without_toes_gives_toe_weights_to_the_feet(model):
+    """default_no_toes uses the default rig's weights: those of toes it lacks go to their
+    nearest ancestor it has (the foot, or its one toe bone), not to the root."""
+    toes = Human({}, rig="default_no_toes", model=model)
+    full = Human({}, rig="default", model=model)
+    dense = toes.weights.dense(len(toes.skeleton.names))
+    names = full.skeleton.names
+    on_toes = full.weights.dense(len(names))[:, [j for j, n in enumerate(names)
+                                                  if n.startswith("toe")]].sum(axis=1)  # fmt: skip
+    tips = on_toes > 0.99
+    assert tips.sum() > 100
+    feet = [j for j, n in enumerate(toes.skeleton.names) if n.startswith(("foot", "toe"))]
+    assert len(feet) < len([n for n in names if n.startswith(("foot", "toe"))])
+    np.testing.assert_allclose(dense[tips][:, feet].sum(axis=1), 1.0, atol=0.01)
+    assert dense[tips, toes.skeleton.names.index("root")].max() == 0.0
+
+
 def test_identity_pose_returns_the_rest_mesh(human):
     for method in ("lbs", "dqs"):
         posed = human.posed(human.pose("rest"), method=method)[0]

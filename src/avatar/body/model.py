@@ -209,14 +209,34 @@ class BodyModel:
         key = (rig, bone_names)
         if key not in self._skin_weights:
             bones, offsets, vertex, weight = self.assets.weights(rig)
-            index = {b: i for i, b in enumerate(bone_names)}
-            bone_ids = np.array([index.get(b, -1) for b in bones])
+            bone_ids = self._weight_bones(rig, bones, bone_names)
             bone_of_entry = np.repeat(bone_ids, np.diff(offsets))
-            keep = bone_of_entry >= 0  # weights of bones this rig lacks (none in shipped rigs)
+            keep = bone_of_entry >= 0
+            bone_of_entry, vertex, weight = bone_of_entry[keep], vertex[keep], weight[keep]
+            # several bones of the weights' rig may land on one bone of this rig: one entry
+            pairs = vertex.astype(np.int64) * len(bone_names) + bone_of_entry
+            merged, inverse = np.unique(pairs, return_inverse=True)
+            if len(merged) < len(pairs):
+                weight = np.bincount(inverse, weights=weight)
+                bone_of_entry, vertex = merged % len(bone_names), merged // len(bone_names)
             self._skin_weights[key] = SkinWeights.from_lists(
-                len(self.base.vertices), bone_of_entry[keep], vertex[keep], weight[keep]
+                len(self.base.vertices), bone_of_entry, vertex, weight
             )
         return self._skin_weights[key]
+
+    def _weight_bones(self, rig: str, bones: list[str], bone_names: tuple[str, ...]):
+        """(len(bones),) index in ``bone_names`` of each bone of the rig's weights file; a
+        bone this rig lacks (default_no_toes uses the default rig's weights, toes included)
+        gives its weights to its nearest ancestor that the rig has, as MakeHuman does
+        (else the toes would follow the root); -1: none."""
+        index = {b: i for i, b in enumerate(bone_names)}
+        source = self.assets.rig(assets.WEIGHTS_FILE.get(rig, rig))
+        out = []
+        for b in bones:
+            while b is not None and b not in index:
+                b = source.get(b, {}).get("parent")
+            out.append(index[b] if b is not None else -1)
+        return np.array(out, dtype=int)
 
     # ------------------------------------------------------------------ parameters
     @cached_property
