@@ -7,9 +7,11 @@
 2. Posed frames: a 300-frame walk, body skinned + garments skinned and resolved per frame;
    goal > 60 frames/s. Anchor: skinning the body alone.
 3. Penetration: random bodies (all ages, both sexes, extreme weights) x every built-in
-   garment (as four layered outfits), in rest pose and over the walk (every 10th frame) and,
-   when the test fixtures are present, CMU's forward jumps. Reports the deepest garment
-   vertex inside the body (goal: <= 1 mm).
+   garment (as four layered outfits) and, when the test fixtures are present, the MakeHuman
+   fixture garments, in rest pose, over the walk and (every 10th body, when the fixtures are
+   present) CMU's forward jumps, every ``--step``-th frame at 30 fps. Reports the deepest
+   garment vertex inside the body (goal: <= 1 mm), confirmed by the winding number, split
+   into free and pinched (where skinning pushed one body part into another; see ``Worst``).
 """
 
 from __future__ import annotations
@@ -19,9 +21,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 import avatar
-from avatar.clothes import collision, library
+from avatar.clothes import collision, fitting, library
 from avatar.rig import kinematics, skinning
 
 OUTFITS = [("tshirt", "jeans", "socks", "shoes", "cap"),
@@ -78,55 +81,128 @@ def posed_frames(model, frames: int) -> None:
           f"skinning alone {1 / alone:.0f} frames/s, ratio {dressed / alone:.1f}x")  # fmt: skip
 
 
-def worst_penetration(model, bodies: int) -> None:
+MH_CLOTHES = JUMP.parents[1] / "makehuman"
+PINCH_REACH = 0.03  # m: skin inside the body this close to a garment vertex pinches it
+
+
+def mh_outfits() -> list[tuple[str, ...]]:
+    """The MakeHuman fixture garments as outfits (paths), when the fixtures are present."""
+    found = sorted(str(p) for p in MH_CLOTHES.glob("*/*/*.mhclo"))
+    suits = [p for p in found if "suit" in p]
+    rest = [p for p in found if "suit" not in p and "eyebrow" not in p and "eyelash" not in p]
+    return [(suit, *rest[i % len(rest) : i % len(rest) + 1]) for i, suit in enumerate(suits)]
+
+
+class Worst:
+    """Deepest garment vertex inside the body, per case, split by where the body is whole.
+
+    free: the skin around the vertex is not inside another body part.
+    pinched: skinning pushed one body part into another within ``PINCH_REACH`` of the
+        vertex (a thigh into the belly in a crouch): there the body has no outside between
+        the parts, so a garment caught between them is inside one of them.
+    """
+
+    def __init__(self):
+        self.depth: dict[str, float] = {}
+        self.where: dict[str, str] = {}
+
+    def add(self, case: str, depth: float, where: str) -> None:
+        if depth > self.depth.get(case, -1.0):
+            self.depth[case], self.where[case] = depth, where
+
+    def line(self) -> str:
+        return ", ".join(
+            f"{k} {v * 1e3:.2f} mm ({self.where[k]})" for k, v in sorted(self.depth.items())
+        )
+
+
+def check_frame(worst: Worst, case: str, body, surface, faces, outfit, verts_list, label) -> None:
+    """Measure one frame: the winding number (right even where the body passes into itself)
+    finds the garment vertices inside the body, the exact distance to all its triangles
+    says how deep, and the skin around them tells free from pinched."""
+    x = body[:13380]
+    normals = surface.normals(x)
+    for g, verts in zip(outfit.garments, verts_list, strict=True):
+        worst.add(case + " free", 0.0, "-")
+        inside = np.flatnonzero(collision.winding_number(verts, x, surface.triangles) > 0)
+        if len(inside) == 0:
+            continue
+        depth = np.zeros(len(verts), np.float32)
+        depth[inside] = collision.surface_distance(verts[inside], x, surface.triangles)
+        # Skin within reach of the vertex (its depth plus PINCH_REACH) that lies inside
+        # the body itself: one part pushed into another there.
+        reach = depth[inside] + PINCH_REACH
+        near = cKDTree(x).query_ball_point(verts[inside], reach)
+        skin = np.unique(np.concatenate([np.asarray(n, np.int64) for n in near]))
+        lifted = x[skin] + 5e-4 * normals[skin]
+        overlap = skin[collision.winding_number(lifted, x, surface.triangles) > 0]
+        pinched = np.zeros(len(inside), bool)
+        if len(overlap):
+            gap = cKDTree(x[overlap]).query(verts[inside])[0]
+            pinched = gap < reach
+        for kind, mask in (("free", ~pinched), ("pinched", pinched)):
+            if mask.any():
+                worst.add(f"{case} {kind}", float(depth[inside][mask].max()), f"{g.name}, {label}")
+
+
+def random_body(rng) -> dict[str, float]:
+    return {"gender": rng.uniform(), "age": rng.uniform(0.0, 1.0),
+            "weight": rng.choice([0.0, 1.0, rng.uniform()]), "muscle": rng.uniform(),
+            "height": rng.uniform()}  # fmt: skip
+
+
+def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
     rng = np.random.default_rng(2020)
+    surface = fitting.body_surface(model.base.faces)
     faces = model.base.faces[model.base.face_groups["body"]]
-    worst = {"rest": 0.0, "walk": 0.0, "jump": 0.0}
     jump = avatar.load_bvh(JUMP / "01_01_forward_jumps.bvh") if JUMP.is_dir() else None
+    outfits = [("built-in", names) for names in OUTFITS] + [("MakeHuman", o) for o in mh_outfits()]
+    worst = Worst()
+    start = time.perf_counter()
     for i in range(bodies):
-        params = {"gender": rng.uniform(), "age": rng.uniform(0.0, 1.0),
-                  "weight": rng.choice([0.0, 1.0, rng.uniform()]), "muscle": rng.uniform(),
-                  "height": rng.uniform()}  # fmt: skip
-        for names in OUTFITS:
+        params = random_body(rng)
+        label = ", ".join(f"{k} {v:.2f}" for k, v in params.items())
+        for kind, names in outfits:
             human = avatar.Human(params, model=model).dressed(*names)
             outfit = human.outfit
-            for part in library.parts(outfit):
-                d = collision.penetration(human.vertices[:13380], faces, part.mesh.vertices)[1]
-                worst["rest"] = max(worst["rest"], float(d.max()))
-            clips = {"walk": avatar.walk(human.skeleton, seconds=1.0, fps=10)}
-            if jump is not None and i % 10 == 0:
-                clips["jump"] = avatar.retarget(*jump, human.skeleton, frames=slice(0, 2700, 90),
-                                                measure=False)[0]  # fmt: skip
+            rest = [g.mesh.vertices for g in outfit.garments]
+            check_frame(worst, f"{kind} rest", human.vertices, surface, faces, outfit, rest, label)
+            clips = {"walk": avatar.walk(human.skeleton, seconds=1.2, fps=30 / step)}
+            if jump is not None and i % jump_every == 0:
+                clips["jump"] = avatar.retarget(*jump, human.skeleton, measure=False,
+                                                frames=slice(0, 2752, 3 * step))[0]  # fmt: skip
             for name, clip in clips.items():
-                worst[name] = max(worst[name], _motion_worst(human, outfit, clip, faces))
-        if (i + 1) % 10 == 0:
-            print(f"  {i + 1} bodies: worst depth (mm) " +
-                  ", ".join(f"{k} {v * 1e3:.2f}" for k, v in worst.items()), flush=True)  # fmt: skip
-    print(f"penetration over {bodies} bodies x {sum(map(len, OUTFITS))} garments: " +
-          ", ".join(f"{k} {v * 1e3:.2f} mm" for k, v in worst.items()) + " (goal <= 1 mm)")  # fmt: skip
-
-
-def _motion_worst(human, outfit, clip, faces) -> float:
-    mats = kinematics.skinning_matrices(
-        human.skeleton, kinematics.forward(human.skeleton, clip.rotations, clip.translations)
-    )
-    worst = 0.0
-    for t in range(clip.frames):
-        body = skinning.linear_blend(human.vertices, human.weights, mats[t])
-        for verts in outfit.frame(body, mats[t]):
-            worst = max(worst, float(collision.penetration(body[:13380], faces, verts)[1].max()))
-    return worst
+                mats = kinematics.skinning_matrices(
+                    human.skeleton,
+                    kinematics.forward(human.skeleton, clip.rotations, clip.translations),
+                )
+                for t in range(clip.frames):
+                    body = skinning.linear_blend(human.vertices, human.weights, mats[t])
+                    frame = outfit.frame(body, mats[t])
+                    where = f"{label}, frame {t}"
+                    check_frame(worst, f"{kind} {name}", body, surface, faces, outfit, frame, where)
+        if (i + 1) % 5 == 0 or i + 1 == bodies:
+            print(
+                f"  {i + 1} bodies, {time.perf_counter() - start:.0f} s: {worst.line()}", flush=True
+            )
+    print(f"penetration over {bodies} bodies (goal <= 1 mm, free):")
+    for case in sorted(worst.depth):
+        print(f"  {case:28s} {worst.depth[case] * 1e3:7.2f} mm  ({worst.where[case]})")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", type=int, default=200)
     parser.add_argument("--frames", type=int, default=300)
+    parser.add_argument("--jump-every", type=int, default=10, help="jump on every Nth body")
+    parser.add_argument("--step", type=int, default=3, help="check every Nth frame (30 fps)")
+    parser.add_argument("--only-penetration", action="store_true")
     args = parser.parse_args()
     model = avatar.BodyModel.load()
-    shape_change(model)
-    posed_frames(model, args.frames)
-    worst_penetration(model, args.bodies)
+    if not args.only_penetration:
+        shape_change(model)
+        posed_frames(model, args.frames)
+    worst_penetration(model, args.bodies, args.jump_every, args.step)
 
 
 if __name__ == "__main__":

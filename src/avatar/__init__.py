@@ -1,8 +1,8 @@
 """Avatar: realistic, rigged, dressed and animated 3D humans from MakeHuman's body model.
 
-    import avatar
-    human = avatar.Human({"gender": 1.0, "pca/belly": 1.0})
-    avatar.save(human, "human.glb", avatar.walk(human.skeleton))
+import avatar
+human = avatar.Human({"gender": 1.0, "pca/belly": 1.0})
+avatar.save(human, "human.glb", avatar.walk(human.skeleton))
 """
 
 from __future__ import annotations

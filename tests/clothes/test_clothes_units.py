@@ -46,6 +46,39 @@ def test_signed_distance_and_push_out_on_a_cube():
     assert collision.penetration(CUBE.vertices, CUBE.faces, moved)[0] == 0
 
 
+def _solid_angle_winding(points, vertices, triangles):
+    """Exact winding number by summed solid angles (Van Oosterom and Strackee)."""
+    a, b, c = (vertices[triangles[:, i]][None] - points[:, None] for i in range(3))
+    la, lb, lc = (np.linalg.norm(v, axis=2) for v in (a, b, c))
+    det = np.einsum("ptd,ptd->pt", a, np.cross(b, c))
+    dots = (np.einsum("ptd,ptd->pt", a, b) * lc + np.einsum("ptd,ptd->pt", b, c) * la
+            + np.einsum("ptd,ptd->pt", c, a) * lb)  # fmt: skip
+    omega = 2 * np.arctan2(det, la * lb * lc + dots)
+    return np.rint(omega.sum(axis=1) / (4 * np.pi)).astype(int)
+
+
+def test_winding_number_counts_overlapping_solids():
+    """Two overlapping cubes (as a skinned body passing into itself): 2 in the overlap,
+    1 in either alone, 0 outside; agrees with the solid-angle formula everywhere."""
+    tris = np.concatenate([CUBE.faces[:, [0, 1, 2]], CUBE.faces[:, [0, 2, 3]]])
+    vertices = np.concatenate([CUBE.vertices, CUBE.vertices + [1.0, 0.5, 0.25]])
+    triangles = np.concatenate([tris, tris + 8])
+    points = np.random.default_rng(0).uniform(-1.5, 2.5, (2000, 3)).astype(np.float32)
+    got = collision.winding_number(points, vertices, triangles, cell=0.3)
+    assert np.array_equal(got, _solid_angle_winding(points, vertices, triangles))
+    assert set(np.unique(got)) == {0, 1, 2}
+    known = collision.winding_number(np.array([[1.5, 1, 0.75], [0.5, 0.5, 0.5], [-0.5] * 3,
+                                               [2.2, 0, 0]]), vertices, triangles)  # fmt: skip
+    assert known.tolist() == [1, 2, 1, 0]
+
+
+def test_surface_distance_is_exact_on_a_cube():
+    tris = np.concatenate([CUBE.faces[:, [0, 1, 2]], CUBE.faces[:, [0, 2, 3]]])
+    points = np.array([[0, 0, 0.5], [0, 0, 3], [2, 2, 2], [0.9, 0.2, 0.1]], np.float32)
+    got = collision.surface_distance(points, CUBE.vertices, tris)
+    assert np.allclose(got, [0.5, 2, np.sqrt(3), 0.1], atol=1e-5)
+
+
 def test_transferred_weights_follow_the_references():
     body = SkinWeights(np.array([[0, 1], [1, 2], [2, 0]], np.int32),
                        np.array([[0.5, 0.5], [1.0, 0], [1.0, 0]], np.float32))  # fmt: skip

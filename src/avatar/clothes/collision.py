@@ -242,6 +242,91 @@ def penetration(
     return int(np.count_nonzero(depth > tolerance)), depth
 
 
+def winding_number(
+    points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, cell: float = 0.005
+) -> np.ndarray:
+    """(N,) int winding number of a closed, outward-oriented triangle surface at points.
+
+    1 inside, 0 outside, and 2 where a skinned body passes into itself: unlike a
+    closest-point sign it stays right where the surface self-intersects. Counted along a
+    ray going up from each point: +1 for each crossing of an upward-facing triangle
+    (leaving), -1 for a downward-facing one (entering). Only the triangles over the
+    point's ``cell`` (m) of an xy grid are tested.
+    """
+    x = np.asarray(vertices, dtype=np.float64)
+    c = x[np.asarray(triangles)]  # (T, 3, 3)
+    # A fixed irrational nudge keeps rays off the shared edges of axis-aligned data.
+    p = np.asarray(points, dtype=np.float64) + np.array([1.1e-7, 0.7e-7, 0.0])
+    pair_point, pair_tri = _column_pairs(p[:, :2], c[..., :2], cell)
+    a, b, d = c[pair_tri, 0], c[pair_tri, 1], c[pair_tri, 2]
+    # Barycentrics of the point's xy in the triangle's xy projection.
+    e1, e2, r = b[:, :2] - a[:, :2], d[:, :2] - a[:, :2], p[pair_point, :2] - a[:, :2]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    safe = np.where(det != 0, det, 1.0)
+    v = (r[:, 0] * e2[:, 1] - r[:, 1] * e2[:, 0]) / safe
+    w = (e1[:, 0] * r[:, 1] - e1[:, 1] * r[:, 0]) / safe
+    hit = (det != 0) & (v >= 0) & (w >= 0) & (v + w <= 1)
+    z = a[:, 2] + v * (b[:, 2] - a[:, 2]) + w * (d[:, 2] - a[:, 2])
+    hit &= z > p[pair_point, 2]
+    return (
+        np.bincount(pair_point[hit], weights=np.sign(det[hit]), minlength=len(p))
+        .round()
+        .astype(np.int64)
+    )
+
+
+def _column_pairs(
+    points_xy: np.ndarray, triangles_xy: np.ndarray, cell: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(point, triangle) index pairs whose xy grid cells meet: each triangle is filed
+    under every cell its xy bounding box touches, each point looks in its own cell."""
+    lo, hi = triangles_xy.min(axis=1), triangles_xy.max(axis=1)
+    origin = lo.min(axis=0)
+    i0 = np.floor((lo - origin) / cell).astype(np.int64)
+    i1 = np.floor((hi - origin) / cell).astype(np.int64)
+    rows = int(i1[:, 1].max()) + 1
+    span = i1 - i0 + 1
+    count = span[:, 0] * span[:, 1]
+    tri = np.repeat(np.arange(len(triangles_xy)), count)
+    k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
+    cx = i0[tri, 0] + k % span[tri, 0]
+    cy = i0[tri, 1] + k // span[tri, 0]
+    cells = cx * rows + cy
+    order = np.argsort(cells, kind="stable")
+    cells, tri = cells[order], tri[order]
+    pc = np.floor((points_xy - origin) / cell).astype(np.int64)
+    valid = (pc[:, 0] >= 0) & (pc[:, 1] >= 0) & (pc[:, 1] < rows)
+    key = np.where(valid, pc[:, 0] * rows + pc[:, 1], -1)
+    start = np.searchsorted(cells, key, "left")
+    stop = np.where(valid, np.searchsorted(cells, key, "right"), start)
+    n = stop - start
+    pair_point = np.repeat(np.arange(len(points_xy)), n)
+    pair_tri = tri[np.repeat(start, n) + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)]
+    return pair_point, pair_tri
+
+
+def surface_distance(
+    points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray, chunk: int = 16
+) -> np.ndarray:
+    """(N,) float32 exact unsigned distance (m) from points to the nearest of all triangles.
+
+    Brute force, O(N T): for checking a few points (``query`` only searches the rings of
+    the nearest vertices, which can miss the closest triangle inside a fold).
+    """
+    x = np.asarray(vertices, dtype=np.float32)
+    t = np.asarray(triangles)
+    a, b, c = x[t[:, 0]], x[t[:, 1]], x[t[:, 2]]
+    p = np.asarray(points, dtype=np.float32)
+    out = np.empty(len(p), np.float32)
+    for start in range(0, len(p), chunk):
+        q = p[start : start + chunk, None, :]
+        bary = closest_on_triangles(q, a[None], b[None], c[None])  # (n, T, 3)
+        close = bary[..., :1] * a + bary[..., 1:2] * b + bary[..., 2:] * c
+        gap = q - close
+        out[start : start + chunk] = np.sqrt(_dot(gap, gap).min(axis=1))
+    return out
+
+
 def push_out(points: np.ndarray, q: SurfaceQuery, clearance: np.ndarray | float) -> np.ndarray:
     """(N, 3) float32 points moved along the body normal until each is ``clearance`` (m,
     scalar or (N,)) outside the body; points already that far out do not move."""

@@ -154,7 +154,7 @@ class Pose:
         Returns (points (N, 3) float32, query at the final positions).
         """
         q = self.query_near(points)
-        need = np.float32(garment.clearance)
+        need = np.full(len(points), garment.clearance, np.float32)
         for _ in range(iterations):
             need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
             short = np.flatnonzero(q.distance < need - 1e-5)
@@ -329,7 +329,7 @@ class Outfit:
             if len(anchor) > 4:
                 need, near = np.concatenate([need, need]), np.concatenate([near, anchor[7]])
             out.append(remote_contacts(self.surface, self.rest_body, x, normals, tree, points,
-                                       need, near, facing))  # fmt: skip
+                                       need, near, facing, iterations=4))  # fmt: skip
         return out
 
 
@@ -342,13 +342,16 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
     only when close to the skin, get the exact search."""
     dist, near = tree.query(points, k=1, distance_upper_bound=REMOTE_REACH)
     close = np.isfinite(dist)
-    near = np.where(close, near, 0)
+    far = np.flatnonzero(~close)
+    near[far] = tree.query(points[far], k=1)[1] if len(far) else near[far]
     apart = np.linalg.norm(reference[near] - reference[rest_near], axis=1)
     turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
     # The nearest vertex's tangent plane is a second, independent opinion: where it says
-    # "too close" although the anchor did not, look properly.
+    # "too close" although the anchor did not, look properly. It also catches points far
+    # from every skin vertex because they are deep inside another part (a skirt's hem
+    # swept into the belly by a raised thigh), not far outside.
     plane = np.einsum("nd,nd->n", points - x[near], normals[near]) < need - PLANE_SLACK
-    remote = np.flatnonzero(close & ((apart > REMOTE) | turned | plane))
+    remote = np.flatnonzero((close & ((apart > REMOTE) | turned)) | plane)
     if len(remote) == 0:
         return points
     points = points.copy()
@@ -364,18 +367,6 @@ def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
     if g.garment.shell is None or q is None:
         return points
     return extrude(points, q.normal, g.garment.thickness)
-
-
-def outward(garment: Garment, points: np.ndarray, body_normal: np.ndarray) -> np.ndarray:
-    """(N, 3) the garment surface's own unit normals, turned to the body's outside.
-
-    The shell grows along these, not along the body normal: where the body folds (the
-    crotch, an armpit) the body normal points into the neighbouring part, the cloth's not.
-    """
-    n = garment.topology.normals(points)
-    flip = np.einsum("nd,nd->n", n, body_normal) < 0
-    n[flip] *= -1
-    return n
 
 
 def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple | None:
