@@ -4,8 +4,9 @@
 
 Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
 from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``,
-download the binary wheel of its one dependency Blender lacks (SciPy; Blender ships numpy,
-and pygltflib/tqdm are imported only by glTF export and the CLI) for the target platform and
+download the binary wheels of the dependencies Blender lacks (SciPy, and Pillow for garment
+textures; Blender ships numpy, and pygltflib/tqdm are imported only by glTF export and the
+CLI) for the target platform and
 Blender's Python, list them in the manifest, then run Blender's own ``blender_ext.py build``
 and ``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
 (``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
@@ -97,13 +98,15 @@ def build_wheel(folder: Path) -> Path:
 
 
 def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Path]:
-    """SciPy's binary wheel for ``platform`` and ``python``, the version installed here."""
+    """SciPy's and Pillow's binary wheels for ``platform`` and ``python``, the versions
+    installed here (Blender ships numpy but neither of these)."""
     from importlib.metadata import version
 
     before = set(folder.glob("*.whl"))
     _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
          "--only-binary=:all:", "--python-version", python, "--platform",
-         PIP_PLATFORMS[platform], "-d", folder, f"scipy=={version('scipy')}")  # fmt: skip
+         PIP_PLATFORMS[platform], "-d", folder, f"scipy=={version('scipy')}",
+         f"pillow=={version('pillow')}")  # fmt: skip
     return sorted(set(folder.glob("*.whl")) - before)
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar import assets
-from avatar.io import jpeg
+from avatar.io import images
 from avatar.material import Material
 
 log = logging.getLogger(__name__)
@@ -182,7 +182,7 @@ def _cached_masks(key: str, files: tuple[tuple[str, Path], ...], size: int):
                 return {name: data[name].astype(np.float32) / 255.0 for name in data.files}
         except (OSError, ValueError, KeyError):
             log.warning("ignoring unreadable skin mask cache %s", cache)
-    masks8 = {name: _resize(jpeg.read(path), size) for name, path in files}
+    masks8 = {name: _resize(images.read(path), size) for name, path in files}
     for m in masks8.values():
         m[m < 4] = 0  # JPEG ringing leaves faint noise everywhere; it is not a region
     try:

@@ -87,13 +87,11 @@ def _read_material(path: Path, proxy: ProxyFile) -> Material | None:
 def material_from_file(mat_path: str | os.PathLike[str]) -> Material:
     """A Material from a ``.mhmat`` (diffuse, normal and alpha; FormatError if the diffuse
     texture is missing)."""
-    from avatar.io import png
-
     mat_path = Path(mat_path)
     mf = mhmat.read(mat_path)
     textures = mhmat.texture_paths(mf, mat_path.parent, mat_path)
-    diffuse = _image(textures.get("diffuseTexture"), png)
-    normal = _image(textures.get("normalmapTexture"), png)
+    diffuse = _image(textures.get("diffuseTexture"))
+    normal = _image(textures.get("normalmapTexture"))
     if normal is not None:
         normal = normal[..., :3] if normal.ndim == 3 else np.repeat(normal[..., None], 3, 2)
     transparent = mf.flag("transparent") or (
@@ -112,17 +110,10 @@ def material_from_file(mat_path: str | os.PathLike[str]) -> Material:
     )
 
 
-def _image(path: Path | None, png) -> np.ndarray | None:
-    if path is None:
-        return None
-    if path.suffix.lower() in (".jpg", ".jpeg"):
-        from avatar.io import jpeg
+def _image(path: Path | None) -> np.ndarray | None:
+    from avatar.io import images
 
-        return jpeg.read(path)
-    image = png.read(path)
-    if image.ndim == 3 and image.shape[2] == 2:  # grey + alpha -> RGBA
-        image = np.concatenate([np.repeat(image[..., :1], 3, 2), image[..., 1:]], 2)
-    return image
+    return None if path is None else images.read(path)
 
 
 def _category(path: Path, proxy: ProxyFile) -> str:

@@ -13,7 +13,7 @@ import numpy as np
 import pygltflib as g
 
 from avatar.io import gltf_accessors as acc
-from avatar.io import png
+from avatar.io import images, png
 from avatar.material import Material
 
 DEFAULT = Material("default")
@@ -119,8 +119,6 @@ def read_material(gltf, buffers, index: int | None) -> Material | None:
 
 def _read_texture(gltf, buffers, texture_index: int) -> np.ndarray:
     """Decode a texture's image (PNG or JPEG, from a buffer view, data URI or file)."""
-    from avatar.io import jpeg
-
     img = gltf.images[gltf.textures[texture_index].source]
     if img.bufferView is not None:
         data = acc.view_bytes(gltf, buffers, img.bufferView)
@@ -128,7 +126,7 @@ def _read_texture(gltf, buffers, texture_index: int) -> np.ndarray:
         data = base64.b64decode(img.uri.split(",", 1)[1])
     else:
         raise ValueError(f"external image files are not read ({img.uri})")
-    pixels = jpeg.decode(data) if data[:2] == b"\xff\xd8" else png.decode(data)
+    pixels = images.decode(data)
     return pixels if pixels.ndim == 3 else np.repeat(pixels[..., None], 3, axis=2)
 
 
