@@ -168,7 +168,7 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
             rest = [g.mesh.vertices for g in outfit.garments]
             check_frame(worst, f"{kind} rest", human.vertices, surface, faces, outfit, rest, label)
             clips = {"walk": avatar.walk(human.skeleton, seconds=1.2, fps=30 / step)}
-            if jump is not None and i % jump_every == 0:
+            if jump is not None and jump_every and i % jump_every == 0:
                 clips["jump"] = avatar.retarget(*jump, human.skeleton, measure=False,
                                                 frames=slice(0, 2752, 3 * step))[0]  # fmt: skip
             for name, clip in clips.items():
@@ -194,7 +194,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", type=int, default=200)
     parser.add_argument("--frames", type=int, default=300)
-    parser.add_argument("--jump-every", type=int, default=10, help="jump on every Nth body")
+    parser.add_argument("--jump-every", type=int, default=10, help="jump on every Nth body (0: never)")
     parser.add_argument("--step", type=int, default=3, help="check every Nth frame (30 fps)")
     parser.add_argument("--only-penetration", action="store_true")
     args = parser.parse_args()

@@ -55,7 +55,8 @@ def motion() -> list[Path]:
         jumper = Human({"gender": 0.1, "muscle": 0.7}, model=model).dressed(
             "tanktop", "leggings", "shoes", "hair-ponytail", "eyebrows")  # fmt: skip
         skeleton, anim = avatar.load_bvh(clip / "01_01_forward_jumps.bvh")
-        jump, _ = avatar.retarget(skeleton, anim, jumper.skeleton, frames=slice(120, 360), fps=24)
+        # Retargeting onto the Human (not just its skeleton) stands the clip on its soles.
+        jump, _ = avatar.retarget(skeleton, anim, jumper, frames=slice(120, 360), fps=24)
         out.append(_strip(jumper, jump, IMAGES / "jump.png", 8))
     return out
 

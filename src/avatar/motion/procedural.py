@@ -2,6 +2,8 @@
 
 A walk cycle written as joint angles about world axes (sagittal swing of hips, knees,
 ankles, shoulders and elbows, pelvis yaw and bob), converted into each bone's rest frame.
+The arms first come down from the rig's rest (MakeHuman's A-pose) to hang at the sides;
+the elbow's hinge turns with them, so the forearm swings forward, not across the body.
 It drives MakeHuman's default-family rigs (default, default_no_toes, game_engine*) by name;
 other rigs receive it through retargeting.
 """
@@ -24,6 +26,7 @@ WALK = {
     "upperarm01": (X, 18.0, np.pi, 0.0),
     "lowerarm01": (X, -10.0, np.pi, -12.0),
 }
+ARM_HANG = 10.0  # deg out from straight down, where the walk's arms hang
 ALIASES = {"upperleg01": ("upperleg01", "thigh"), "lowerleg01": ("lowerleg01", "calf"),
            "foot": ("foot",), "upperarm01": ("upperarm01", "upperarm"),
            "lowerarm01": ("lowerarm01", "lowerarm")}  # fmt: skip
@@ -42,15 +45,21 @@ def walk(
     rot = np.zeros((len(t), j, 4))
     rot[..., 0] = 1.0
     trans = np.zeros((len(t), j, 3))
-    for key, (axis, amp, shift, offset) in WALK.items():
-        for side, sign in ((".L", 0.0), (".R", np.pi)):
+    for side, sign in ((".L", 0.0), (".R", np.pi)):
+        hang = _arm_hang(skeleton, side)
+        for key, (axis, amp, shift, offset) in WALK.items():
             bone = _find(skeleton, key, side)
             if bone is None:
                 continue
             angle = np.radians(offset + amp * np.sin(phase + shift + sign))
             if key == "lowerleg01":  # knees only bend one way
                 angle = np.radians(offset * 0.2) + np.maximum(angle - np.radians(offset * 0.8), 0)
-            rot[:, bone] = _local(skeleton, bone, quaternion.from_axis_angle(axis, angle))
+            if key == "lowerarm01":  # the hinge as it was before the arm came down
+                axis = quaternion.to_matrix(hang).T @ axis
+            q = quaternion.from_axis_angle(axis, angle)
+            if key == "upperarm01":
+                q = quaternion.multiply(q, hang)
+            rot[:, bone] = _local(skeleton, bone, q)
     root = int(np.flatnonzero(skeleton.parents < 0)[0])
     legs = _leg_length(skeleton)
     world = np.zeros((len(t), 3))
@@ -61,6 +70,18 @@ def walk(
         skeleton, root, quaternion.from_axis_angle(Z, np.radians(4) * np.sin(phase))
     )
     return Animation(rot, trans, fps, skeleton.names)
+
+
+def _arm_hang(skeleton: Skeleton, side: str) -> np.ndarray:
+    """(4,) the world rotation taking the upper arm from its rest to hanging at the side
+    (identity without an arm)."""
+    shoulder, elbow = _find(skeleton, "upperarm01", side), _find(skeleton, "lowerarm01", side)
+    if shoulder is None or elbow is None:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    rest = skeleton.heads[elbow] - skeleton.heads[shoulder]
+    out = np.sign(rest[0]) * np.sin(np.radians(ARM_HANG))
+    hang = np.array([out, 0.0, -np.cos(np.radians(ARM_HANG))])
+    return quaternion.between(rest / np.linalg.norm(rest), hang)
 
 
 def _find(skeleton: Skeleton, key: str, side: str) -> int | None:

@@ -1,0 +1,43 @@
+"""The built-in walk: arms hang at the sides and swing fore and aft, legs alternate."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import avatar
+from avatar.rig import kinematics
+
+
+@pytest.fixture(scope="module")
+def walking():
+    human = avatar.Human({"gender": 0.8})
+    clip = avatar.walk(human.skeleton, seconds=1.0, fps=30)
+    world = kinematics.forward(human.skeleton, clip.rotations, clip.translations)
+    return human.skeleton, np.asarray(world)
+
+
+def _point(skeleton, world, name):
+    return world[:, skeleton.names.index(name), :3, 3]
+
+
+@pytest.mark.parametrize("side", [".L", ".R"])
+def test_arms_hang_at_the_sides_and_swing(walking, side):
+    skeleton, world = walking
+    arm = _point(skeleton, world, "lowerarm01" + side) - _point(skeleton, world, "upperarm01" + side)
+    arm /= np.linalg.norm(arm, axis=1, keepdims=True)
+    down = np.degrees(np.arccos(-arm[:, 2]))
+    assert down.max() < 25  # never held out in the rest A-pose (45 degrees)
+    assert np.ptp(arm[:, 1]) > np.sin(np.radians(20))  # swings fore and aft
+    # The forearm bends forward, in the arm's swing plane, not across the body.
+    hand = _point(skeleton, world, "wrist" + side) - _point(skeleton, world, "lowerarm01" + side)
+    hinge = np.cross(arm, hand)
+    hinge /= np.linalg.norm(hinge, axis=1, keepdims=True)
+    assert np.abs(hinge[:, 0]).min() > 0.9
+
+
+def test_legs_alternate(walking):
+    skeleton, world = walking
+    left = _point(skeleton, world, "foot.L")[:, 1]
+    right = _point(skeleton, world, "foot.R")[:, 1]
+    assert np.corrcoef(np.diff(left), np.diff(right))[0, 1] < 0.5
