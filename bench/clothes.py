@@ -194,7 +194,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", type=int, default=200)
     parser.add_argument("--frames", type=int, default=300)
-    parser.add_argument("--jump-every", type=int, default=10, help="jump on every Nth body (0: never)")
+    parser.add_argument(
+        "--jump-every", type=int, default=10, help="jump on every Nth body (0: never)"
+    )
     parser.add_argument("--step", type=int, default=3, help="check every Nth frame (30 fps)")
     parser.add_argument("--only-penetration", action="store_true")
     args = parser.parse_args()
