@@ -24,9 +24,8 @@ def _point(skeleton, world, name):
 @pytest.mark.parametrize("side", [".L", ".R"])
 def test_arms_hang_at_the_sides_and_swing(walking, side):
     skeleton, world = walking
-    arm = _point(skeleton, world, "lowerarm01" + side) - _point(
-        skeleton, world, "upperarm01" + side
-    )
+    elbow = _point(skeleton, world, "lowerarm01" + side)
+    arm = elbow - _point(skeleton, world, "upperarm01" + side)
     arm /= np.linalg.norm(arm, axis=1, keepdims=True)
     down = np.degrees(np.arccos(-arm[:, 2]))
     assert down.max() < 25  # never held out in the rest A-pose (45 degrees)
