@@ -67,7 +67,7 @@ def shape_change(model) -> None:
 def posed_frames(model, frames: int) -> None:
     human = avatar.Human({"gender": 0.6}, model=model).dressed(*FOUR)
     outfit = human.outfit
-    walk = avatar.walk(human.skeleton, seconds=frames / 30, fps=30)
+    walk = avatar.walk(human, seconds=frames / 30, fps=30)
     mats = kinematics.skinning_matrices(
         human.skeleton, kinematics.forward(human.skeleton, walk.rotations, walk.translations)
     )
@@ -162,25 +162,31 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
     for i in range(bodies):
         params = random_body(rng)
         label = ", ".join(f"{k} {v:.2f}" for k, v in params.items())
+        body = avatar.Human(params, model=model)
+        clips = {"walk": avatar.walk(body, seconds=1.2, fps=30 / step)}
+        if jump is not None and jump_every and i % jump_every == 0:
+            clips["jump"] = avatar.retarget(*jump, body, measure=False,
+                                            frames=slice(0, 2752, 3 * step))[0]  # fmt: skip
+        mats = {
+            name: kinematics.skinning_matrices(
+                body.skeleton,
+                kinematics.forward(body.skeleton, clip.rotations, clip.translations),
+            )
+            for name, clip in clips.items()
+        }
         for kind, names in outfits:
-            human = avatar.Human(params, model=model).dressed(*names)
+            human = body.dressed(*names)
             outfit = human.outfit
             rest = [g.mesh.vertices for g in outfit.garments]
             check_frame(worst, f"{kind} rest", human.vertices, surface, faces, outfit, rest, label)
-            clips = {"walk": avatar.walk(human.skeleton, seconds=1.2, fps=30 / step)}
-            if jump is not None and jump_every and i % jump_every == 0:
-                clips["jump"] = avatar.retarget(*jump, human.skeleton, measure=False,
-                                                frames=slice(0, 2752, 3 * step))[0]  # fmt: skip
-            for name, clip in clips.items():
-                mats = kinematics.skinning_matrices(
-                    human.skeleton,
-                    kinematics.forward(human.skeleton, clip.rotations, clip.translations),
-                )
-                for t in range(clip.frames):
-                    body = skinning.linear_blend(human.vertices, human.weights, mats[t])
-                    frame = outfit.frame(body, mats[t])
+            for name, m in mats.items():
+                for t in range(len(m)):
+                    posed = skinning.linear_blend(human.vertices, human.weights, m[t])
+                    frame = outfit.frame(posed, m[t])
                     where = f"{label}, frame {t}"
-                    check_frame(worst, f"{kind} {name}", body, surface, faces, outfit, frame, where)
+                    check_frame(
+                        worst, f"{kind} {name}", posed, surface, faces, outfit, frame, where
+                    )
         if (i + 1) % 5 == 0 or i + 1 == bodies:
             print(
                 f"  {i + 1} bodies, {time.perf_counter() - start:.0f} s: {worst.line()}", flush=True

@@ -47,9 +47,7 @@ def motion() -> list[Path]:
     model = BodyModel.load()
     walker = Human({"gender": 0.8, "age": 0.35}, model=model).dressed(
         "tshirt", "jeans", "shoes", "hair-short", "eyebrows")  # fmt: skip
-    out = [
-        _strip(walker, avatar.walk(walker.skeleton, seconds=1.0, fps=24), IMAGES / "walk.png", 4)
-    ]
+    out = [_strip(walker, avatar.walk(walker, seconds=1.0, fps=24), IMAGES / "walk.png", 4)]
     clip = Path(__file__).resolve().parents[2] / "shared/fixtures/bvh/cmu_motionbuilder"
     if (clip / "01_01_forward_jumps.bvh").is_file():
         jumper = Human({"gender": 0.1, "muscle": 0.7}, model=model).dressed(

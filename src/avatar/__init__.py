@@ -2,7 +2,7 @@
 
 import avatar
 human = avatar.Human({"gender": 1.0, "pca/belly": 1.0})
-avatar.save(human, "human.glb", avatar.walk(human.skeleton))
+avatar.save(human, "human.glb", avatar.walk(human))
 """
 
 from __future__ import annotations

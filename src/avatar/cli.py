@@ -218,7 +218,7 @@ def _animation(human, args: argparse.Namespace):
     from avatar.motion.procedural import MOTIONS
 
     if args.motion in MOTIONS:
-        return MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0), args.motion
+        return MOTIONS[args.motion](human, fps=args.fps or 30.0), args.motion
     if args.motion:
         from pathlib import Path
 

@@ -4,17 +4,24 @@ A walk cycle written as joint angles about world axes (sagittal swing of hips, k
 ankles, shoulders and elbows, pelvis yaw and bob), converted into each bone's rest frame.
 The arms first come down from the rig's rest (MakeHuman's A-pose) to hang at the sides;
 the elbow's hinge turns with them, so the forearm swings forward, not across the body.
+Given a Human, each arm hangs as close to the side as its skin stays clear of the torso,
+with room for clothes on both (heavier bodies hold their arms further out, as people do).
 It drives MakeHuman's default-family rigs (default, default_no_toes, game_engine*) by name;
 other rigs receive it through retargeting.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from avatar.errors import AvatarError
 from avatar.rig import quaternion
 from avatar.rig.skeleton import Animation, Skeleton
+
+if TYPE_CHECKING:
+    from avatar.human import Human
 
 X, Z = np.array([1.0, 0, 0]), np.array([0, 0, 1.0])
 
@@ -26,19 +33,23 @@ WALK = {
     "upperarm01": (X, 18.0, np.pi, 0.0),
     "lowerarm01": (X, -10.0, np.pi, -12.0),
 }
-ARM_HANG = 10.0  # deg out from straight down, where the walk's arms hang
+ARM_HANG = 15.0  # deg out from straight down, where the walk's arms hang at the closest
+ARM_ROOM = 0.012  # m of air a hanging arm keeps from the torso (a garment on each side)
+ARM_BONES = ("upperarm", "lowerarm")  # not the hand: fingers lie within ARM_ROOM of each other
 ALIASES = {"upperleg01": ("upperleg01", "thigh"), "lowerleg01": ("lowerleg01", "calf"),
            "foot": ("foot",), "upperarm01": ("upperarm01", "upperarm"),
            "lowerarm01": ("lowerarm01", "lowerarm")}  # fmt: skip
 
 
 def walk(
-    skeleton: Skeleton, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0
+    target: Skeleton | Human, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0
 ) -> Animation:
     """A walk of ``seconds`` along -Y at ``cadence`` strides (two steps) per second.
 
+    target: a rig, or a Human (its rig, with the arms hung clear of its own torso).
     Stride length scales with leg length, so every body walks at its own natural speed.
     """
+    skeleton = target if isinstance(target, Skeleton) else target.skeleton
     t = np.arange(int(round(seconds * fps))) / fps
     phase = 2 * np.pi * cadence * t
     j = len(skeleton.names)
@@ -46,7 +57,8 @@ def walk(
     rot[..., 0] = 1.0
     trans = np.zeros((len(t), j, 3))
     for side, sign in ((".L", 0.0), (".R", np.pi)):
-        hang = _arm_hang(skeleton, side)
+        out = ARM_HANG if isinstance(target, Skeleton) else _clear_hang(target, side)
+        hang = _arm_hang(skeleton, side, out)
         for key, (axis, amp, shift, offset) in WALK.items():
             bone = _find(skeleton, key, side)
             if bone is None:
@@ -72,16 +84,43 @@ def walk(
     return Animation(rot, trans, fps, skeleton.names)
 
 
-def _arm_hang(skeleton: Skeleton, side: str) -> np.ndarray:
-    """(4,) the world rotation taking the upper arm from its rest to hanging at the side
-    (identity without an arm)."""
+def _arm_hang(skeleton: Skeleton, side: str, degrees: float) -> np.ndarray:
+    """(4,) the world rotation taking the upper arm from its rest to hanging ``degrees``
+    out from straight down (identity without an arm)."""
     shoulder, elbow = _find(skeleton, "upperarm01", side), _find(skeleton, "lowerarm01", side)
     if shoulder is None or elbow is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
     rest = skeleton.heads[elbow] - skeleton.heads[shoulder]
-    out = np.sign(rest[0]) * np.sin(np.radians(ARM_HANG))
-    hang = np.array([out, 0.0, -np.cos(np.radians(ARM_HANG))])
+    out = np.sign(rest[0]) * np.sin(np.radians(degrees))
+    hang = np.array([out, 0.0, -np.cos(np.radians(degrees))])
     return quaternion.between(rest / np.linalg.norm(rest), hang)
+
+
+def _clear_hang(human: Human, side: str) -> float:
+    """Degrees out from straight down (ARM_HANG..45, in 3-degree steps) at which the arm's
+    skin, grown by ARM_ROOM, is first outside the body, posed by linear blend skinning."""
+    from avatar.clothes import collision, fitting
+    from avatar.rig import kinematics, skinning
+
+    skeleton, weights = human.skeleton, human.weights
+    skin = fitting.BODY_VERTEX_COUNT
+    arm = [i for i, n in enumerate(skeleton.names) if n.endswith(side) and n.startswith(ARM_BONES)]
+    share = np.isin(weights.indices[:skin], arm) * weights.weights[:skin]
+    points = np.flatnonzero(share.sum(axis=1) > 0.95)  # the arm itself, not the shoulder
+    shoulder = _find(skeleton, "upperarm01", side)
+    if shoulder is None or len(points) == 0:
+        return ARM_HANG
+    surface = fitting.body_surface(human.model.base.faces)
+    rot = np.zeros((1, len(skeleton.names), 4))
+    rot[..., 0] = 1.0
+    for degrees in np.arange(ARM_HANG, 45.0, 3.0):
+        rot[0, shoulder] = _local(skeleton, shoulder, _arm_hang(skeleton, side, degrees))
+        mats = kinematics.skinning_matrices(skeleton, kinematics.forward(skeleton, rot))[0]
+        x = skinning.linear_blend(human.vertices, weights, mats)[:skin]
+        grown = x[points] + ARM_ROOM * surface.normals(x)[points]
+        if not np.any(collision.winding_number(grown, x, surface.triangles) > 0):
+            return float(degrees)
+    return 45.0
 
 
 def _find(skeleton: Skeleton, key: str, side: str) -> int | None:
