@@ -28,9 +28,12 @@ from avatar.rig.skinning import SkinWeights, linear_blend
 BODY_VERTEX_COUNT = 13380  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
+REMOTE_K = 3  # nearest skin vertices whose rest places tell another body part
+CLOSING = 0.01  # m that skin may come closer to a point's anchor before it is another part
 REMOTE_REACH = 0.06  # m; points further than this from every skin vertex are not checked
 FOLD = 0.3  # cosine between anchor and nearest-skin normals below which the skin folded
 PLANE_SLACK = 0.002  # m the tangent-plane estimate may fall short before it is checked
+CAUGHT = -0.3  # cosine between two successive push directions: caught between two parts
 REMOTE = 0.02  # m at rest between a point's anchor and its nearest skin: another body part
 FLOOR_REACH = 0.04  # m; garment parts further out (loose hems, hair ends) define no layer
 FRAME_INFLUENCES = 4  # bones per vertex when skinning garments frame by frame (speed)
@@ -337,29 +340,44 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
                     iterations: int = 1):  # fmt: skip
     """Push points out of body parts other than the skin they are anchored to (an arm
     swinging into a shirt's side, one thigh into the other trouser leg). Such a point's
-    nearest skin vertex now lies far, at rest, from its nearest one at rest, or faces
-    another way than its anchor (a fold closing, as in the crotch); only those few, and
-    only when close to the skin, get the exact search."""
-    dist, near = tree.query(points, k=1, distance_upper_bound=REMOTE_REACH)
-    close = np.isfinite(dist)
+    nearest skin vertex now lies far, at rest, from its nearest one at rest; or one of
+    its three nearest came closer to that one than it was at rest (skin pressing in,
+    even where its vertex is not the nearest); or it faces another way than its anchor
+    (a fold closing, as in the crotch). Only those few get the exact search."""
+    dist, near3 = tree.query(points, k=REMOTE_K, distance_upper_bound=REMOTE_REACH)
+    close = np.isfinite(dist[:, 0])
+    near3 = np.where(np.isfinite(dist), near3, near3[:, :1])
     far = np.flatnonzero(~close)
-    near[far] = tree.query(points[far], k=1)[1] if len(far) else near[far]
-    apart = np.linalg.norm(reference[near] - reference[rest_near], axis=1)
+    if len(far):
+        near3[far] = tree.query(points[far], k=1)[1][:, None]
+    near = near3[:, 0]
+    rest_gap = np.linalg.norm(reference[near3] - reference[rest_near][:, None], axis=2)
+    gap = np.linalg.norm(x[near3] - x[rest_near][:, None], axis=2)
+    other = (rest_gap[:, 0] > REMOTE) | ((rest_gap - gap).max(axis=1) > CLOSING)
     turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
     # The nearest vertex's tangent plane is a second, independent opinion: where it says
     # "too close" although the anchor did not, look properly. It also catches points far
     # from every skin vertex because they are deep inside another part (a skirt's hem
     # swept into the belly by a raised thigh), not far outside.
     plane = np.einsum("nd,nd->n", points - x[near], normals[near]) < need - PLANE_SLACK
-    remote = np.flatnonzero((close & ((apart > REMOTE) | turned)) | plane)
+    remote = np.flatnonzero((close & (other | turned)) | plane)
     if len(remote) == 0:
         return points
     points = points.copy()
-    for _ in range(iterations):  # between two parts one push can land in the other
+    before = None
+    for _ in range(iterations):
         exact = collision.query(x, surface, points[remote], k=4, tree=tree, normals=normals)
-        if np.all(exact.distance >= need[remote] - 1e-5):
+        short = exact.distance < need[remote] - 1e-5
+        if not short.any():
             break
-        points[remote] = collision.push_out(points[remote], exact, need[remote])
+        moved = collision.push_out(points[remote], exact, need[remote])
+        if before is not None:
+            # Pushed out of one part straight into the facing one (an arm against the
+            # chest): the middle of the gap between the two is as far from both as it gets.
+            caught = short & (np.einsum("nd,nd->n", exact.normal, before.normal) < CAUGHT)
+            moved[caught] = 0.5 * (exact.closest[caught] + before.closest[caught])
+        before = exact
+        points[remote] = moved
     return points
 
 
