@@ -108,3 +108,19 @@ def test_covered_skin_is_kept_unless_hidden(model):
     assert len(kept.mesh.vertices) == 13380
     assert 0 < len(hidden.mesh.vertices) < 13380
     assert hidden.skin[0].shape[0] == len(hidden.mesh.vertices)
+
+
+def test_a_garment_fits_a_body_the_same_whatever_it_met_before(model):
+    """Anchors come from the default body, not from the first body a garment meets, so
+    a dataset's garments do not depend on the order its bodies were made in."""
+    from dataclasses import replace
+
+    shorts = library.load_garment("shorts")
+    heavy = Human({"gender": 0.7, "weight": 1.0}, model=model)
+    thin = Human({"gender": 0.2, "weight": 0.0, "age": 0.2}, model=model)
+    fresh = replace(shorts)
+    direct = library.dress(heavy, [fresh]).garments[0].mesh.vertices
+    fresh = replace(shorts)
+    library.dress(thin, [fresh])
+    after = library.dress(heavy, [fresh]).garments[0].mesh.vertices
+    np.testing.assert_array_equal(direct, after)

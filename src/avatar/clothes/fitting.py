@@ -71,8 +71,9 @@ class Garment:
     @cached_property
     def anchor_cache(self) -> dict:
         """Closest skin triangles of the garment's layers, found once by the exact search on
-        the first body it is fitted to; the body's topology never changes, so later fits
-        and frames measure against the same triangles in O(N) (``collision.anchored``)."""
+        the model's default body (or the first body it meets, for bodies without a model);
+        the body's topology never changes, so later fits and frames measure against the
+        same triangles in O(N) (``collision.anchored``)."""
         return {}
 
     @cached_property
@@ -449,6 +450,11 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
         vertices) and ``faces`` (or ``model.base.faces``); an ``avatar.human.Human`` works.
     Returns an Outfit whose ``garments`` keep the input's layer order.
     """
+    _anchor_on_default_body(human, garments)
+    return _dress(human, garments, bone_names)
+
+
+def _dress(human, garments: list[Garment], bone_names) -> Outfit:
     vertices = np.asarray(human.vertices, dtype=np.float32)
     surface = body_surface(_body_faces(human))
     pose = Pose(surface, vertices)
@@ -481,3 +487,18 @@ def dress(human, garments: list[Garment], bone_names=None) -> Outfit:
             mesh = _check_outer(pose, mesh, anchors[-1])
             fitted[-1] = replace(fitted[-1], mesh=mesh)
     return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
+
+
+def _anchor_on_default_body(human, garments: list[Garment]) -> None:
+    """Find new garments' anchor triangles (``Garment.anchor_cache``) on the model's default
+    body, each garment alone: a garment then fits a body the same way whichever bodies it
+    met before (a dataset does not depend on its order)."""
+    new = [g for g in garments if g.collide and "inner" not in g.anchor_cache]
+    model = getattr(human, "model", None)
+    if not new or model is None:
+        return
+    from avatar.human import Human
+
+    default = Human({}, human.recipe.rig, model)
+    for garment in new:
+        _dress(default, [garment], None)
