@@ -389,12 +389,16 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
         short = exact.distance < need[remote] - 1e-5
         if not short.any():
             break
+        # Points far enough out stay put, so only the short ones are looked at again.
+        keep = np.flatnonzero(short)
+        remote, exact = remote[keep], _take(exact, keep)
         moved = collision.push_out(points[remote], exact, need[remote])
         if before is not None:
             # Pushed out of one part straight into the facing one (an arm against the
             # chest): the middle of the gap between the two is as far from both as it gets.
-            caught = short & (np.einsum("nd,nd->n", exact.normal, before.normal) < CAUGHT)
-            moved[caught] = 0.5 * (exact.closest[caught] + before.closest[caught])
+            prior = _take(before, keep)
+            caught = np.einsum("nd,nd->n", exact.normal, prior.normal) < CAUGHT
+            moved[caught] = 0.5 * (exact.closest[caught] + prior.closest[caught])
         before = exact
         points[remote] = moved
     return points
