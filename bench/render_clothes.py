@@ -2,7 +2,9 @@
 
     python bench/render_clothes.py [--samples 16] [--out docs/images]
 
-Needs the pip ``bpy`` module. Rest pose, plus one mid-motion frame when a clip is given.
+Needs the pip ``bpy`` module. Rest pose, or with ``--walk`` mid-stride in the built-in walk
+(docs/images/clothes_walk_*.png): the body skinned and the garments as ``Outfit.frame``
+resolves them for that frame, rendered as still meshes.
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ import argparse
 import os
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-blender-"))
 
@@ -23,6 +27,33 @@ BODIES = [
     ({"gender": 1.0, "age": 0.25, "muscle": 1.0}, ("eyebrows", "eyelashes", "hair-short", "hoodie", "leggings", "shoes")),  # noqa: E501
     ({"gender": 0.0, "age": 0.5, "weight": 0.4}, ("eyebrows-blond", "eyelashes", "hair-long", "swimsuit")),  # noqa: E501
 ]  # fmt: skip
+
+
+class Posed:
+    """A dressed Human frozen in one frame: still meshes at their posed places."""
+
+    def __init__(self, human, outfit, matrices):
+        from avatar.clothes.library import parts
+        from avatar.part import MeshPart
+        from avatar.rig import skinning
+
+        self.human, self.skeleton = human, human.skeleton
+        body = skinning.linear_blend(human.vertices, human.weights, matrices)
+        garments = outfit.frame(body, matrices)
+        # Walk in place: the frame keeps the body where the rest pose stood.
+        shift = np.zeros(3, np.float32)
+        shift[:2] = (body[:13380] - human.vertices[:13380]).mean(axis=0)[:2]
+        self._parts = [
+            MeshPart(p.name, p.mesh.with_vertices(body[human.part_vertices(p.name)] - shift),
+                     p.material)
+            for p in human.parts()
+        ] + [
+            MeshPart(p.name, p.mesh.with_vertices(v - shift), p.material)
+            for p, v in zip(parts(outfit), garments, strict=True)
+        ]  # fmt: skip
+
+    def parts(self):
+        return self._parts
 
 
 class Dressed:
@@ -43,6 +74,7 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=16)
     parser.add_argument("--out", default="docs/images")
     parser.add_argument("--texture", type=int, default=512)
+    parser.add_argument("--walk", action="store_true", help="mid-stride in the built-in walk")
     args = parser.parse_args()
     from avatar.blender import render, scene
     from avatar.clothes.library import dress, load_garment
@@ -52,13 +84,27 @@ def main() -> None:
     for i, (params, names) in enumerate(BODIES):
         human = Human(params)
         outfit = dress(human, [load_garment(n, texture_size=args.texture) for n in names])
-        chars.append(scene.character_from_human(Dressed(human, outfit), name=f"dressed{i}"))
+        shown = Dressed(human, outfit)
+        if args.walk:
+            shown = Posed(human, outfit, _mid_stride(human))
+        chars.append(scene.character_from_human(shown, name=f"dressed{i}"))
     out = Path(args.out)
+    stem = "clothes_walk" if args.walk else "clothes"
     for view, direction in (("front", (0.25, -1.0, 0.12)), ("back", (-0.25, 1.0, 0.12))):
         size = (300 * len(chars), 620)
         render.stage_characters(chars, size, spacing=0.7, direction=direction)
-        render.render(out / f"clothes_{view}.png", samples=args.samples, resolution=size)
-        print(out / f"clothes_{view}.png")
+        render.render(out / f"{stem}_{view}.png", samples=args.samples, resolution=size)
+        print(out / f"{stem}_{view}.png")
+
+
+def _mid_stride(human) -> np.ndarray:
+    """(J, 4, 4) skinning matrices a quarter into the built-in walk: legs apart, arms swung."""
+    import avatar
+    from avatar.rig import kinematics
+
+    walk = avatar.walk(human, seconds=1.0, fps=24)
+    world = kinematics.forward(human.skeleton, walk.rotations[6:7], walk.translations[6:7])
+    return kinematics.skinning_matrices(human.skeleton, world)[0]
 
 
 if __name__ == "__main__":
