@@ -155,6 +155,26 @@ def _add_optional(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--folder", action="append", metavar="DIR",
                    help="also scan this MakeHuman/MPFB asset folder; repeatable")  # fmt: skip
     p.set_defaults(run=cli_clothes_list)
+    from avatar.clothes.binder import FRAMES, cli_clothes_bind
+
+    p = clothes_sub.add_parser(
+        "bind", help="bind a garment OBJ modelled on an Avatar body, so it fits every body",
+        description="Bind a garment mesh (OBJ) to the body it was modelled on and save it as "
+        "MakeHuman .mhclo + .obj + .mhmat; from then on it fits every body (--wear PATH).",
+    )  # fmt: skip
+    p.add_argument("garment", metavar="GARMENT.obj")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into")
+    body = p.add_mutually_exclusive_group()
+    body.add_argument("--set", action="append", metavar="NAME=VALUE",
+                      help="the body it was modelled on (as for create); repeatable")  # fmt: skip
+    body.add_argument("--mhm", metavar="FILE", help="the body it was modelled on, as a .mhm file")
+    p.add_argument("--name", help="garment name (default: the file's stem)")
+    p.add_argument("--frame", default="auto", choices=["auto", *FRAMES],
+                   help="the OBJ's axes and units (default: whichever fits the body)")  # fmt: skip
+    p.add_argument("--tag", action="append", help="library tag; repeatable")
+    p.add_argument("--z-depth", type=int, default=50, help="layer: higher goes over lower")
+    p.add_argument("--texture", metavar="IMAGE", help="diffuse texture to copy beside it")
+    p.set_defaults(run=cli_clothes_bind)
 
 
 def parse_assignments(items: Sequence[str]) -> dict[str, float]:

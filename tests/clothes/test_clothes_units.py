@@ -204,3 +204,37 @@ def test_scanner_lists_makehuman_assets(fixtures):
     short = next(e for e in entries if e.name == "short02")
     assert short.category == "hair" and short.licence == "CC0" and short.thumbnail
     assert "short" in short.tags
+
+
+def test_clothes_bind_cli_binds_an_obj_in_any_frame_and_refuses_a_stray_one(
+    model, tmp_path, capsys
+):
+    """A garment exported Y-up (Blender's OBJ default) from a body made with --set binds to
+    that body, refits it exactly, and fits another body; a mesh off the body is refused
+    and nothing is written."""
+    from avatar.cli import main
+    from avatar.clothes import library
+    from avatar.human import Human
+    from avatar.io import obj
+
+    body = Human({"weight": 0.8, "gender": 0.3}, model=model)
+    worn = library.dress(body, ["tshirt"]).garments[0].mesh
+    v = worn.vertices
+    exported = worn.with_vertices(np.stack([v[:, 0], v[:, 2], -v[:, 1]], axis=1))  # Y-up
+    obj.write(tmp_path / "shirt.obj", exported)
+    out = tmp_path / "mine"
+    assert main(["clothes", "bind", str(tmp_path / "shirt.obj"), "--set", "weight=0.8",
+                 "--set", "gender=0.3", "--tag", "Top", "-o", str(out)]) == 0  # fmt: skip
+    garment = library.load_garment(str(out / "shirt.mhclo"))
+    assert np.abs(binding.fit(garment.binding, body.vertices) - v).max() < 1e-5
+    assert "top" in garment.tags
+    other = Human({"weight": 0.1, "gender": 0.9, "age": 0.2}, model=model).dressed(
+        str(out / "shirt.mhclo"))  # fmt: skip
+    faces = model.base.faces[model.base.face_groups["body"]]
+    for g in other.outfit.garments:
+        assert collision.penetration(other.vertices[:13380], faces, g.mesh.vertices)[0] == 0
+    obj.write(tmp_path / "stray.obj", exported.with_vertices(exported.vertices + 3.0))
+    assert main(["clothes", "bind", str(tmp_path / "stray.obj"), "--frame", "avatar", "-o",
+                 str(tmp_path / "none")]) != 0  # fmt: skip
+    assert "garment vertex 0" in capsys.readouterr().err
+    assert not (tmp_path / "none").exists()

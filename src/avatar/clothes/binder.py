@@ -62,7 +62,7 @@ def bind(
         i = int(np.flatnonzero(far)[0])
         raise AvatarError(
             f"garment vertex {i} is {dist[i, best[i]]:.2f} m from the body (limit "
-            f"{max_distance} m): was the garment modelled on an Avatar body, in metres, Z-up?"
+            f"{max_distance} m): was it modelled on this body, and in the frame given (--frame)?"
         )
     weights = bary[rows, best]
     indices = tri[rows, best]
@@ -109,3 +109,77 @@ def save(
     path = folder / f"{name}.mhclo"
     mhclo.write(path, proxy)
     return path
+
+
+# Frames a garment OBJ may come in: name -> (metres per unit, Y-up). Y-up files (MakeHuman,
+# Blender's default OBJ export) face +Z; Avatar's frame is Z-up metres facing -Y.
+FRAMES = {"avatar": (1.0, False), "y-up": (1.0, True), "makehuman": (0.1, True),
+          "y-up-cm": (0.01, True), "z-up-cm": (0.01, False)}  # fmt: skip
+
+
+def in_body_frame(
+    vertices: np.ndarray, body_vertices: np.ndarray, frame: str = "auto"
+) -> tuple[np.ndarray, str]:
+    """(N, 3) garment vertices in Avatar's frame, and the frame they came in.
+
+    frame: a ``FRAMES`` name, or "auto": the one that puts the garment closest to the
+    body (median distance to its nearest body vertex).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    if frame != "auto":
+        if frame not in FRAMES:
+            raise AvatarError(f"unknown frame {frame!r}; one of: auto, {', '.join(FRAMES)}")
+        scale, y_up = FRAMES[frame]
+        out = np.stack([v[:, 0], -v[:, 2], v[:, 1]], axis=1) if y_up else v
+        return out * scale, frame
+    tree = cKDTree(np.asarray(body_vertices, dtype=np.float64))
+    tries = {name: in_body_frame(v, body_vertices, name)[0] for name in FRAMES}
+    gap = {name: float(np.median(tree.query(p)[0])) for name, p in tries.items()}
+    best = min(gap, key=gap.__getitem__)
+    return tries[best], best
+
+
+def bind_obj(
+    path: str | os.PathLike[str],
+    human,
+    folder: str | os.PathLike[str],
+    name: str | None = None,
+    frame: str = "auto",
+    tags: tuple[str, ...] = (),
+    z_depth: int = 50,
+    texture: str | os.PathLike[str] | None = None,
+) -> Path:
+    """Bind a garment OBJ modelled on ``human`` (an ``avatar.Human``) and save it in folder
+    as ``name.mhclo`` + ``.obj`` + ``.mhmat`` (with ``texture`` copied beside them); from
+    then on it fits every body. Returns the .mhclo path; on any error nothing is written."""
+    import shutil
+
+    path = Path(path)
+    name = name or path.stem
+    mesh = obj.read(path)
+    body = np.asarray(human.vertices, dtype=np.float64)
+    vertices, _ = in_body_frame(mesh.vertices, body, frame)
+    base = human.model.base
+    binding = bind(vertices, body, base.faces[base.face_groups["body"]])
+    entries = [("name", name), ("diffuseColor", "0.8 0.8 0.8")]
+    if texture is not None and not Path(texture).is_file():
+        raise AvatarError(f"{texture}: texture file not found")
+    if texture is not None:
+        entries.append(("diffuseTexture", f"{name}{Path(texture).suffix.lower()}"))
+    out = save(folder, name, mesh.with_vertices(vertices.astype(np.float32)), binding,
+               mhmat.MaterialFile(tuple(entries)), z_depth, tags)  # fmt: skip
+    if texture is not None:
+        shutil.copyfile(texture, Path(folder) / entries[-1][1])
+    return out
+
+
+def cli_clothes_bind(args) -> int:
+    """``avatar clothes bind GARMENT.obj [--set ...] -o FOLDER``: see ``bind_obj``."""
+    from avatar.cli import parse_assignments
+    from avatar.human import Human
+
+    human = Human.from_mhm(args.mhm) if args.mhm else Human(parse_assignments(args.set or []))
+    path = bind_obj(args.garment, human, args.output, args.name, args.frame,
+                    tuple(args.tag or ()), args.z_depth, args.texture)  # fmt: skip
+    print(f"wrote {path}: wear it on any body with --wear {path}")
+    return 0
