@@ -363,7 +363,10 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
     even where its vertex is not the nearest); or it faces another way than its anchor
     (a fold closing, as in the crotch). Only those few get the exact search."""
     # All garments in one query, on every core: the largest single cost of a posed frame.
-    dist, near3 = tree.query(points, k=REMOTE_K, distance_upper_bound=REMOTE_REACH, workers=-1)
+    # At rest (reference is the body itself) no skin moved, so the nearest one tells all.
+    k = 1 if reference is x else REMOTE_K
+    dist, near3 = tree.query(points, k=[*range(1, k + 1)], distance_upper_bound=REMOTE_REACH,
+                             workers=-1)  # fmt: skip
     close = np.isfinite(dist[:, 0])
     near3 = np.where(np.isfinite(dist), near3, near3[:, :1])
     far = np.flatnonzero(~close)
