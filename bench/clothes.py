@@ -187,7 +187,7 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
                     check_frame(
                         worst, f"{kind} {name}", posed, surface, faces, outfit, frame, where
                     )
-        if (i + 1) % 5 == 0 or i + 1 == bodies:
+        if (i + 1) % 5 == 0 or i + 1 == bodies or jump_every == 1:
             print(
                 f"  {i + 1} bodies, {time.perf_counter() - start:.0f} s: {worst.line()}", flush=True
             )
