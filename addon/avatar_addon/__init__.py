@@ -48,6 +48,7 @@ CLASSES = (
     operators.AVATAR_OT_refresh_library,
     operators.AVATAR_OT_wear,
     operators.AVATAR_OT_take_off,
+    operators.AVATAR_OT_bind_garment,
     operators.AVATAR_OT_apply_motion,
     panels.AVATAR_UL_garments,
     panels.AVATAR_PT_body,

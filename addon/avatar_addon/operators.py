@@ -32,11 +32,29 @@ def _call(operator, action):
 
 
 def _use_preferences():
-    """The add-on's assets folder, when set, is the library's AVATAR_ASSETS."""
+    """The add-on's folders, when set: assets are the library's AVATAR_ASSETS, and the
+    clothes folder is scanned for the Dress panel's list."""
     addon = bpy.context.preferences.addons.get(__package__)
-    folder = addon.preferences.assets if addon is not None else ""
-    if folder:
-        os.environ["AVATAR_ASSETS"] = bpy.path.abspath(folder)
+    prefs = addon.preferences if addon is not None else None
+    if prefs is not None and prefs.assets:
+        os.environ["AVATAR_ASSETS"] = bpy.path.abspath(prefs.assets)
+    if prefs is not None and prefs.clothes:
+        _scan_clothes(bpy.path.abspath(prefs.clothes))
+
+
+# avatar.clothes.library.ENV_PATH; spelt out so the panels work without the library.
+CLOTHES_PATH = "AVATAR_CLOTHES_PATH"
+
+
+def _clothes_folders():
+    return [p for p in os.environ.get(CLOTHES_PATH, "").split(os.pathsep) if p]
+
+
+def _scan_clothes(folder):
+    """Let the library list the garments in ``folder`` for the rest of this session."""
+    folders = _clothes_folders()
+    if os.path.normpath(folder) not in map(os.path.normpath, folders):
+        os.environ[CLOTHES_PATH] = os.pathsep.join([*folders, folder])
 
 
 def _character():
@@ -139,15 +157,17 @@ class AVATAR_OT_refresh_library(bpy.types.Operator):
     bl_label = "Refresh"
 
     def execute(self, context):
-        def refresh():
-            items = context.scene.avatar.garments
-            items.clear()
-            for name, category, entry in catalogue.garments():
-                item = items.add()
-                item.name, item.category, item.entry = name, category, entry
-            return f"{len(items)} garments"
+        return _call(self, lambda: f"{_refresh_garments(context.scene.avatar)} garments")
 
-        return _call(self, refresh)
+
+def _refresh_garments(settings):
+    """Fill the Dress panel's list from the library; returns how many it holds."""
+    items = settings.garments
+    items.clear()
+    for name, category, entry in catalogue.garments():
+        item = items.add()
+        item.name, item.category, item.entry = name, category, entry
+    return len(items)
 
 
 class _DressOperator:
@@ -205,6 +225,72 @@ class AVATAR_OT_apply_motion(bpy.types.Operator):
         return _call(self, lambda: _character().apply_motion(obj, motion))
 
 
+class AVATAR_OT_bind_garment(bpy.types.Operator):
+    """Save the selected mesh, modelled on an Avatar character, as a garment that fits every body"""
+
+    bl_idname = "avatar.bind_garment"
+    bl_label = "Bind Selected as Garment"
+
+    name: bpy.props.StringProperty(name="Name", description="The garment's name and file name")
+    folder: bpy.props.StringProperty(
+        name="Folder", subtype="DIR_PATH",
+        description="Where to save it (default: your clothes folder, which the list scans)",
+    )  # fmt: skip
+    tags: bpy.props.StringProperty(name="Tags", description="Comma-separated, e.g. top, casual")
+
+    @classmethod
+    def poll(cls, context):
+        return _garment_object(context) is not None
+
+    def invoke(self, context, event):
+        _use_preferences()
+        self.name = bpy.path.clean_name(_garment_object(context).name)  # not the last one's
+        self.folder = self.folder or _default_clothes_folder()
+        return context.window_manager.invoke_props_dialog(self)
+
+    def execute(self, context):
+        garment = _garment_object(context)
+        body = next((o for o in context.selected_objects if o is not garment and _root_of(o)), None)
+        name = bpy.path.clean_name(self.name.strip() or garment.name)  # a safe file name
+        tags = tuple(t.strip() for t in self.tags.split(",") if t.strip())
+
+        def bind():
+            folder = bpy.path.abspath(self.folder) if self.folder else _default_clothes_folder()
+            path = _character().bind_garment(garment, folder, name, tags, body)
+            _show_in_library(context.scene.avatar, folder, path)
+            return f"Saved {path}: wear it from the Dress panel"
+
+        return _call(self, bind)
+
+
+def _garment_object(context):
+    """The mesh to bind: the active object or the one selected mesh that is not part of a
+    character; else an active selected mesh parented to one (modelled in its hierarchy)."""
+    active = context.active_object
+    meshes = [o for o in context.selected_objects if o.type == "MESH"]
+    free = [o for o in meshes if _root_of(o) is None]
+    if active in free:
+        return active
+    if len(free) == 1:
+        return free[0]
+    return active if active in meshes and not free else None
+
+
+def _default_clothes_folder():
+    """The first clothes folder the library scans, else one in Blender's user resources."""
+    folders = _clothes_folders()
+    return folders[0] if folders else bpy.utils.user_resource("DATAFILES", path="avatar/clothes")
+
+
+def _show_in_library(settings, folder, path):
+    """List the new garment in the Dress panel (scanning its folder from now on), selected."""
+    _scan_clothes(folder)
+    _refresh_garments(settings)
+    entries = [os.path.normpath(g.entry) for g in settings.garments]
+    if os.path.normpath(str(path)) in entries:
+        settings.garment_index = entries.index(os.path.normpath(str(path)))
+
+
 def _rebuild(context, obj, recipe, verb):
     """Rebuild ``obj``'s character from ``recipe``, keep it active; a one-line report."""
     built = _character().update(obj, recipe)
@@ -223,11 +309,18 @@ def _select(context, built):
 
 def _stored_recipe(context):
     """The recipe of the character the active object belongs to, or None."""
-    obj = context.object
+    root = _root_of(context.object)
+    if root is None:
+        return None
+    import json
+
+    return json.loads(root["avatar_recipe"])
+
+
+def _root_of(obj):
+    """The character root (holding the recipe) ``obj`` belongs to, or None; no library needed."""
     while obj is not None:
         if "avatar_recipe" in obj.keys():
-            import json
-
-            return json.loads(obj["avatar_recipe"])
+            return obj
         obj = obj.parent
     return None

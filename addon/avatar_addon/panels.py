@@ -68,6 +68,7 @@ class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
         row.operator("avatar.refresh_library", icon="FILE_REFRESH")
         row.operator("avatar.wear", icon="ADD")
         row.operator("avatar.take_off", icon="REMOVE")
+        layout.operator("avatar.bind_garment", icon="MOD_CLOTH")
 
 
 class AVATAR_PT_motion(_AvatarPanel, bpy.types.Panel):

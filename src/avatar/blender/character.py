@@ -13,9 +13,12 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from pathlib import Path
 
 import bpy
+from mathutils import Vector
 
+from avatar.blender import mesh as mesh_bridge
 from avatar.blender import scene as stage
 
 RECIPE_KEY = "avatar_recipe"
@@ -116,6 +119,50 @@ def load_motion(motion: Mapping[str, object], human) -> object:
         in_place=bool(motion.get("in_place")),
     )
     return animation
+
+
+def bind_garment(
+    garment: bpy.types.Object,
+    folder: str,
+    name: str,
+    tags: tuple[str, ...] = (),
+    body: bpy.types.Object | None = None,
+) -> Path:
+    """Save the mesh object ``garment``, modelled on a character, as a garment that fits every
+    body: ``folder/name.mhclo`` + ``.obj`` + ``.mhmat``; returns the .mhclo Path.
+
+    body: an object of that character; None finds it (see ``authoring_root``). The garment is
+    read as it shows and brought into the character's frame (Avatar's: its root is the
+    origin), then bound to the body its recipe realises. Raises AvatarError (e.g. a vertex too
+    far from the body) before anything is written.
+    """
+    from avatar.clothes import binder
+
+    root = authoring_root(garment, body)
+    mesh = mesh_bridge.read_evaluated_mesh(garment, root.matrix_world.inverted())
+    human = realise(recipe_of(root))
+    base = human.model.base
+    binding = binder.bind(mesh.vertices, human.vertices, base.faces[base.face_groups["body"]])
+    return binder.save(folder, name, mesh, binding, tags=tags)
+
+
+def authoring_root(
+    garment: bpy.types.Object, body: bpy.types.Object | None = None
+) -> bpy.types.Object:
+    """The root of the character ``garment`` was modelled on: ``body``'s, else the one it is
+    parented to, else the scene's character whose root is nearest to the garment's centre."""
+    for obj in (body, garment):
+        root = root_of(obj)
+        if root is not None:
+            return root
+    roots = [o for o in bpy.context.scene.objects if RECIPE_KEY in o.keys()]
+    if not roots:
+        from avatar.errors import AvatarError
+
+        raise AvatarError("no Avatar character in the scene to bind the garment to")
+    corners = [garment.matrix_world @ Vector(c) for c in garment.bound_box]
+    centre = sum(corners, Vector()) / len(corners)
+    return min(roots, key=lambda r: (r.matrix_world.translation - centre).length)
 
 
 def root_of(obj: bpy.types.Object | None) -> bpy.types.Object | None:

@@ -145,3 +145,54 @@ def read_mesh(obj: bpy.types.Object) -> Mesh:
         uvs = uvs.reshape(-1, 2)
         face_uvs = np.arange(len(uvs), dtype=np.int32).reshape(-1, corners)
     return Mesh(_vertices(data), loops.reshape(-1, corners), uvs, face_uvs)
+
+
+def read_evaluated_mesh(obj: bpy.types.Object, to_frame=None) -> Mesh:
+    """The object as it shows (modifiers, shape keys applied) as a Mesh record in world space,
+    or in the frame the 4x4 ``to_frame`` maps world space to (e.g. a character's).
+
+    Blender meshes mix triangles, quads and n-gons, the record holds one (F, N) array: n-gons
+    become their triangles, and next to quads a triangle repeats its last corner (as
+    ``avatar.io.obj`` reads such meshes). UVs are the active layer's, equal values merged.
+    """
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    data = evaluated.to_mesh()
+    try:
+        corners = _face_corners(data)
+        loop_vertex = np.empty(len(data.loops), dtype=np.int32)
+        data.loops.foreach_get("vertex_index", loop_vertex)
+        vertices = _vertices(data).astype(np.float64)
+        loop_uvs = None
+        if data.uv_layers.active is not None:
+            loop_uvs = np.empty(len(data.loops) * 2, dtype=np.float32)
+            data.uv_layers.active.data.foreach_get("uv", loop_uvs)
+    finally:
+        evaluated.to_mesh_clear()
+    matrix = obj.matrix_world if to_frame is None else to_frame @ obj.matrix_world
+    m = np.array(matrix, dtype=np.float64)
+    vertices = vertices @ m[:3, :3].T + m[:3, 3]
+    uvs = face_uvs = None
+    if loop_uvs is not None:
+        uvs, inverse = np.unique(loop_uvs.reshape(-1, 2), axis=0, return_inverse=True)
+        face_uvs = inverse.reshape(-1).astype(np.int32)[corners]
+    return Mesh(vertices.astype(np.float32), loop_vertex[corners], uvs, face_uvs)
+
+
+def _face_corners(data: bpy.types.Mesh) -> np.ndarray:
+    """(F, N) loop indices of the faces, N = 4 if there are quads else 3 (see above)."""
+    start = np.empty(len(data.polygons), dtype=np.int32)
+    total = np.empty(len(data.polygons), dtype=np.int32)
+    data.polygons.foreach_get("loop_start", start)
+    data.polygons.foreach_get("loop_total", total)
+    n = 4 if (total == 4).any() else 3
+    small = total <= 4
+    faces = start[small, None] + np.minimum(np.arange(n), total[small, None] - 1)
+    if small.all():
+        return faces.astype(np.int32)
+    data.calc_loop_triangles()
+    tris = np.empty(len(data.loop_triangles) * 3, dtype=np.int32)
+    data.loop_triangles.foreach_get("loops", tris)
+    owner = np.empty(len(data.loop_triangles), dtype=np.int32)
+    data.loop_triangles.foreach_get("polygon_index", owner)
+    tris = tris.reshape(-1, 3)[~small[owner]]
+    return np.concatenate([faces, tris[:, [0, 1, 2, 2][:n]]]).astype(np.int32)
