@@ -62,7 +62,7 @@ def bind(
         i = int(np.flatnonzero(far)[0])
         raise AvatarError(
             f"garment vertex {i} is {dist[i, best[i]]:.2f} m from the body (limit "
-            f"{max_distance} m): was it modelled on this body, and in the frame given (--frame)?"
+            f"{max_distance} m): was it modelled on this body, in the frame given?"
         )
     weights = bary[rows, best]
     indices = tri[rows, best]
