@@ -28,6 +28,7 @@ from avatar.rig.skinning import SkinWeights, linear_blend
 BODY_VERTEX_COUNT = 13380  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
+THREADED = 4096  # points from which the k-d tree search runs on every core
 REMOTE_K = 3  # nearest skin vertices whose rest places tell another body part
 CLOSING = 0.01  # m that skin may come closer to a point's anchor before it is another part
 REMOTE_REACH = 0.06  # m; points further than this from every skin vertex are not checked
@@ -365,8 +366,9 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
     # All garments in one query, on every core: the largest single cost of a posed frame.
     # At rest (reference is the body itself) no skin moved, so the nearest one tells all.
     k = 1 if reference is x else REMOTE_K
+    workers = -1 if len(points) > THREADED else 1  # threads cost more than small batches
     dist, near3 = tree.query(points, k=[*range(1, k + 1)], distance_upper_bound=REMOTE_REACH,
-                             workers=-1)  # fmt: skip
+                             workers=workers)  # fmt: skip
     close = np.isfinite(dist[:, 0])
     near3 = np.where(np.isfinite(dist), near3, near3[:, :1])
     far = np.flatnonzero(~close)
