@@ -151,7 +151,7 @@ def random_body(rng) -> dict[str, float]:
             "height": rng.uniform()}  # fmt: skip
 
 
-def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
+def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: bool) -> None:
     rng = np.random.default_rng(2020)
     surface = fitting.body_surface(model.base.faces)
     faces = model.base.faces[model.base.face_groups["body"]]
@@ -182,7 +182,7 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int) -> None:
             for name, m in mats.items():
                 for t in range(len(m)):
                     posed = skinning.linear_blend(human.vertices, human.weights, m[t])
-                    frame = outfit.frame(posed, m[t])
+                    frame = outfit.frame(posed, m[t], exact=exact)
                     where = f"{label}, frame {t}"
                     check_frame(
                         worst, f"{kind} {name}", posed, surface, faces, outfit, frame, where
@@ -205,12 +205,15 @@ def main() -> None:
     )
     parser.add_argument("--step", type=int, default=3, help="check every Nth frame (30 fps)")
     parser.add_argument("--only-penetration", action="store_true")
+    parser.add_argument(
+        "--fast", action="store_true", help="measure the real-time path, not frame(exact=True)"
+    )
     args = parser.parse_args()
     model = avatar.BodyModel.load()
     if not args.only_penetration:
         shape_change(model)
         posed_frames(model, args.frames)
-    worst_penetration(model, args.bodies, args.jump_every, args.step)
+    worst_penetration(model, args.bodies, args.jump_every, args.step, not args.fast)
 
 
 if __name__ == "__main__":

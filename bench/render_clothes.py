@@ -4,7 +4,7 @@
 
 Needs the pip ``bpy`` module. Rest pose, or with ``--walk`` mid-stride in the built-in walk
 (docs/images/clothes_walk_*.png): the body skinned and the garments as ``Outfit.frame``
-resolves them for that frame, rendered as still meshes.
+resolves them for that frame (exact), rendered as still meshes.
 """
 
 from __future__ import annotations
@@ -32,14 +32,14 @@ BODIES = [
 class Posed:
     """A dressed Human frozen in one frame: still meshes at their posed places."""
 
-    def __init__(self, human, outfit, matrices):
+    def __init__(self, human, outfit, matrices, exact: bool = True):
         from avatar.clothes.library import parts
         from avatar.part import MeshPart
         from avatar.rig import skinning
 
         self.human, self.skeleton = human, human.skeleton
         body = skinning.linear_blend(human.vertices, human.weights, matrices)
-        garments = outfit.frame(body, matrices)
+        garments = outfit.frame(body, matrices, exact=exact)
         # Walk in place: the frame keeps the body where the rest pose stood.
         shift = np.zeros(3, np.float32)
         shift[:2] = (body[:13380] - human.vertices[:13380]).mean(axis=0)[:2]

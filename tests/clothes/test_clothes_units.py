@@ -238,3 +238,23 @@ def test_clothes_bind_cli_binds_an_obj_in_any_frame_and_refuses_a_stray_one(
                  str(tmp_path / "none")]) != 0  # fmt: skip
     assert "garment vertex 0" in capsys.readouterr().err
     assert not (tmp_path / "none").exists()
+
+
+def test_escape_moves_every_point_out_of_overlapping_solids():
+    """Two overlapping cubes stand for a skinned body passing into itself: points inside
+    either (or both) end outside both with the clearance; points outside stay put."""
+    tris = np.concatenate([CUBE.faces[:, [0, 1, 2]], CUBE.faces[:, [0, 2, 3]]])
+    faces = np.concatenate([CUBE.faces, CUBE.faces + 8])
+    vertices = np.concatenate([CUBE.vertices, CUBE.vertices + [1.0, 0.5, 0.25]])
+    surface = collision.body_surface(faces)
+    triangles = np.concatenate([tris, tris + 8])
+    points = np.random.default_rng(1).uniform(-1.5, 2.5, (500, 3)).astype(np.float32)
+    before = collision.winding_number(points, vertices, triangles, cell=0.3)
+    assert {1, 2} <= set(before.tolist())
+    moved = collision.escape(points, vertices, surface, 0.05)
+    assert not np.any(collision.winding_number(moved, vertices, triangles, cell=0.3))
+    np.testing.assert_array_equal(moved[before == 0], points[before == 0])
+    # Each moved point is outside by the clearance along the interpolated vertex normal
+    # (at a cube's corner that normal is diagonal: 1/sqrt(3) of it from the faces).
+    gap = collision.surface_distance(moved[before > 0], vertices, triangles)
+    assert gap.min() > 0.05 / np.sqrt(3) - 1e-4

@@ -124,3 +124,45 @@ def test_a_garment_fits_a_body_the_same_whatever_it_met_before(model):
     library.dress(thin, [fresh])
     after = library.dress(heavy, [fresh]).garments[0].mesh.vertices
     np.testing.assert_array_equal(direct, after)
+
+
+def _turn(axis: int, degrees: float) -> np.ndarray:
+    q = np.zeros(4)
+    q[0], q[1 + axis] = np.cos(np.radians(degrees) / 2), np.sin(np.radians(degrees) / 2)
+    return q
+
+
+def test_exact_frames_leave_no_garment_vertex_inside_a_body_pressed_into_itself(model):
+    """A heavy body with thighs raised, knees bent, back bent and arms pressed to its sides:
+    skinning drives body parts into each other, yet ``Outfit.frame(exact=True)`` leaves
+    every garment vertex outside (winding number, right even where the body passes into
+    itself), moving only a few."""
+    from avatar.clothes import fitting
+    from avatar.rig import kinematics, skinning
+
+    human = Human({"gender": 0.7, "weight": 1.0, "age": 0.7}, model=model)
+    names = list(human.skeleton.names)
+    rotations = np.tile([1.0, 0.0, 0.0, 0.0], (1, len(names), 1))
+    for side, sign in (("L", 1), ("R", -1)):
+        rotations[0, names.index(f"upperleg01.{side}")] = _turn(0, 95)
+        rotations[0, names.index(f"lowerleg01.{side}")] = _turn(0, -110)
+        rotations[0, names.index(f"upperarm01.{side}")] = _turn(2, 30 * sign)
+    rotations[0, names.index("spine03")] = _turn(0, 25)
+    world = kinematics.forward(human.skeleton, rotations, np.zeros((1, 3)))
+    matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
+    body = skinning.linear_blend(human.vertices, human.weights, matrices)[:13380]
+    triangles = fitting.body_surface(model.base.faces).triangles
+
+    def inside(points, skin=body):
+        return collision.winding_number(points, skin, triangles) > 0
+
+    def pressed(skin):  # skin vertices inside the body: one part driven into another
+        return inside(skin + 5e-4 * fitting.body_surface(model.base.faces).normals(skin), skin)
+
+    assert pressed(body).sum() > 2 * pressed(human.vertices[:13380]).sum()
+    outfit = human.dressed("longsleeve", "hoodie", "trousers").outfit
+    fast = outfit.frame(body, matrices)
+    exact = outfit.frame(body, matrices, exact=True)
+    for g, before, after in zip(outfit.garments, fast, exact, strict=True):
+        assert not inside(after).any(), g.name
+        assert np.any(before != after, axis=1).mean() < 0.01, g.name

@@ -332,3 +332,53 @@ def push_out(points: np.ndarray, q: SurfaceQuery, clearance: np.ndarray | float)
     scalar or (N,)) outside the body; points already that far out do not move."""
     lack = np.maximum(np.asarray(clearance, dtype=np.float32) - q.distance, 0.0)
     return (np.asarray(points, dtype=np.float32) + lack[:, None] * q.normal).astype(np.float32)
+
+
+def escape(
+    points: np.ndarray,
+    vertices: np.ndarray,
+    surface: BodySurface,
+    clearance: np.ndarray | float,
+    tree: cKDTree | None = None,
+    normals: np.ndarray | None = None,
+) -> np.ndarray:
+    """(N, 3) float32 points with every one inside the body moved out of it.
+
+    The inside test is the winding number (exact, and right where a skinned body passes
+    into itself), so this is the last word after faster, local resolves: a point found
+    inside goes to its closest skin point plus ``clearance`` (m, scalar or (N,)) along the
+    normal there; one still inside (that skin was itself inside another part) goes to the
+    nearest skin vertex whose point ``clearance`` out along its normal is outside (among
+    its 16 nearest, else among all).
+    vertices: (V, 3) the body; tree, normals: reuse those built for this pose.
+    """
+    x = np.asarray(vertices, dtype=np.float32)
+    out = np.array(points, dtype=np.float32)
+    need = np.broadcast_to(np.asarray(clearance, np.float32), (len(out),))
+    inside = np.flatnonzero(winding_number(out, x, surface.triangles) > 0)
+    if len(inside) == 0:
+        return out
+    if tree is None:
+        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
+    if normals is None:
+        normals = surface.normals(x)
+    q = query(x, surface, out[inside], k=8, tree=tree, normals=normals)
+    out[inside] = q.closest + need[inside, None] * q.normal
+    inside = inside[winding_number(out[inside], x, surface.triangles) > 0]
+    # Still inside: the closest skin was itself inside another part (skinning pressed them
+    # together). Go to the nearest skin point whose outside really is outside.
+    if len(inside):
+        _, near = tree.query(out[inside], k=16)
+        lifted = x[near] + need[inside, None, None] * normals[near]  # (M, 16, 3)
+        free = winding_number(lifted.reshape(-1, 3), x, surface.triangles).reshape(near.shape)
+        ok = free <= 0
+        first = np.argmax(ok, axis=1)  # nearest first: tree results are sorted
+        found = ok[np.arange(len(inside)), first]
+        out[inside[found]] = lifted[np.flatnonzero(found), first[found]]
+        inside = inside[~found]
+    if len(inside):  # deep in a part sunk into another (an arm into the chest): all skin
+        lifted = x + need[inside].max() * normals
+        free = np.flatnonzero(winding_number(lifted, x, surface.triangles) <= 0)
+        _, nearest = cKDTree(lifted[free]).query(out[inside])
+        out[inside] = lifted[free[nearest]]
+    return out

@@ -292,21 +292,23 @@ class Outfit:
         """Garment vertices (M_i, 3) for one posed frame.
 
         body_posed: (V, 3) the body skinned with ``matrices`` (J, 4, 4) skinning matrices.
-        exact: search the whole body for every vertex (finds contacts with other body parts,
-            ~10x slower); by default each vertex keeps its clearance above the skin it was
-            closest to at rest, which moves with it (real time).
+        exact: guarantee that no garment vertex is inside the body (for datasets and
+            exports; several times slower): after the real-time resolve, every garment
+            vertex is tested by winding number, which stays right where skinning drove one
+            body part into another, and any inside is moved out (``collision.escape``).
+            By default each vertex keeps its clearance above the skin it was closest to at
+            rest, which moves with it, and is checked against other parts that come near.
         """
-        if not exact and len(self.anchors) == len(self.garments):
-            return self._frame_anchored(body_posed, matrices)
-        pose = Pose(self.surface, body_posed)
-        out = []
-        for g, rest, w in zip(self.garments, self.rest_surfaces, self.surface_weights, strict=True):
-            points = linear_blend(rest, w, matrices)
-            if not g.garment.collide:
-                out.append(_shell_frame(g, points, None))
-                continue
-            points, q = pose.resolve(points, g.garment, iterations=1)
-            out.append(_shell_frame(g, points, q))
+        out = self._frame_anchored(body_posed, matrices)
+        if not exact:
+            return out
+        skin = np.asarray(body_posed[:BODY_VERTEX_COUNT], dtype=np.float32)
+        tree = cKDTree(skin, balanced_tree=False, compact_nodes=False)
+        normals = self.surface.normals(skin)
+        for i, (g, anchor) in enumerate(zip(self.garments, self.anchors, strict=True)):
+            if anchor is not None:
+                need = _frame_need(g, anchor, len(out[i]))
+                out[i] = collision.escape(out[i], skin, self.surface, need, tree, normals)
         return out
 
     def _frame_anchored(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
@@ -353,6 +355,15 @@ class Outfit:
             for i, part in zip(index, np.split(joined, np.cumsum(sizes)[:-1]), strict=True):
                 out[i] = part
         return out
+
+
+def _frame_need(g: FittedGarment, anchor: tuple, count: int) -> np.ndarray:
+    """(M,) m each posed garment vertex keeps from the skin: its rest clearance (the
+    layer below plus a gap), and for a shell's outer layer that plus the thickness."""
+    need = anchor[2]
+    if count > len(need):
+        need = np.concatenate([need, need + np.float32(g.garment.thickness)])
+    return need
 
 
 def remote_contacts(surface, reference, x, normals, tree, points, need, rest_near, facing,
