@@ -9,7 +9,8 @@
 3. Penetration: random bodies (all ages, both sexes, extreme weights) x every built-in
    garment (as four layered outfits) and, when the test fixtures are present, the MakeHuman
    fixture garments, in rest pose, over the walk and (every 10th body, when the fixtures are
-   present) CMU's forward jumps, every ``--step``-th frame at 30 fps. Reports the deepest
+   present) CMU's forward jumps, every ``--step``-th (``--jump-step``-th) frame at 30 fps;
+   ``--shard K/N`` runs every Nth body from K, so N processes share the work. Reports the deepest
    garment vertex inside the body (goal: <= 1 mm), confirmed by the winding number, split
    into free and pinched (where skinning pushed one body part into another; see ``Worst``).
 """
@@ -151,22 +152,24 @@ def random_body(rng) -> dict[str, float]:
             "height": rng.uniform()}  # fmt: skip
 
 
-def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: bool) -> None:
+def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: bool,
+                      jump_step: int, shard: tuple[int, int] = (0, 1)) -> None:  # fmt: skip
     rng = np.random.default_rng(2020)
+    every = [random_body(rng) for _ in range(bodies)]  # the same bodies however sharded
     surface = fitting.body_surface(model.base.faces)
     faces = model.base.faces[model.base.face_groups["body"]]
     jump = avatar.load_bvh(JUMP / "01_01_forward_jumps.bvh") if JUMP.is_dir() else None
     outfits = [("built-in", names) for names in OUTFITS] + [("MakeHuman", o) for o in mh_outfits()]
     worst = Worst()
     start = time.perf_counter()
-    for i in range(bodies):
-        params = random_body(rng)
+    for i in range(shard[0], bodies, shard[1]):
+        params = every[i]
         label = ", ".join(f"{k} {v:.2f}" for k, v in params.items())
         body = avatar.Human(params, model=model)
         clips = {"walk": avatar.walk(body, seconds=1.2, fps=30 / step)}
         if jump is not None and jump_every and i % jump_every == 0:
             clips["jump"] = avatar.retarget(*jump, body, measure=False,
-                                            frames=slice(0, 2752, 3 * step))[0]  # fmt: skip
+                                            frames=slice(0, 2752, 3 * jump_step))[0]  # fmt: skip
         mats = {
             name: kinematics.skinning_matrices(
                 body.skeleton,
@@ -187,7 +190,7 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: boo
                     check_frame(
                         worst, f"{kind} {name}", posed, surface, faces, outfit, frame, where
                     )
-        if (i + 1) % 5 == 0 or i + 1 == bodies or jump_every == 1:
+        if (i + 1) % 5 < shard[1] or i + shard[1] >= bodies or jump_every == 1:
             print(
                 f"  {i + 1} bodies, {time.perf_counter() - start:.0f} s: {worst.line()}", flush=True
             )
@@ -204,6 +207,8 @@ def main() -> None:
         "--jump-every", type=int, default=10, help="jump on every Nth body (0: never)"
     )
     parser.add_argument("--step", type=int, default=3, help="check every Nth frame (30 fps)")
+    parser.add_argument("--jump-step", type=int, default=36, help="same, for the jumps")
+    parser.add_argument("--shard", default="0/1", help="K/N: bodies K, K+N, ... (parallel runs)")
     parser.add_argument("--only-penetration", action="store_true")
     parser.add_argument(
         "--fast", action="store_true", help="measure the real-time path, not frame(exact=True)"
@@ -213,7 +218,9 @@ def main() -> None:
     if not args.only_penetration:
         shape_change(model)
         posed_frames(model, args.frames)
-    worst_penetration(model, args.bodies, args.jump_every, args.step, not args.fast)
+    shard = tuple(int(k) for k in args.shard.split("/"))
+    worst_penetration(model, args.bodies, args.jump_every, args.step, not args.fast,
+                      args.jump_step, (shard[0], shard[1]))  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -206,10 +206,11 @@ class Human:
 
     @cached_property
     def outfit(self):
-        """The recipe's garments fitted on this body (``avatar.clothes.fitting.Outfit``)."""
+        """The recipe's garments fitted on this body (``avatar.clothes.fitting.Outfit``),
+        every vertex outside the body (``exact``: this is what exports and renders use)."""
         from avatar.clothes import library
 
-        return library.dress(self, list(self.recipe.clothes))
+        return library.dress(self, list(self.recipe.clothes), exact=True)
 
     def dressed(self, *garments: str) -> Human:
         """A copy of this human also wearing ``garments`` (library names or .mhclo paths)."""

@@ -89,10 +89,15 @@ def load_garment(
     raise unknown_name("garment", text, [e.name for e in list_garments(folders=folders)])
 
 
-def dress(human, garments: Sequence[Garment | str] = DEFAULT_OUTFIT, bone_names=None) -> Outfit:
+def dress(
+    human,
+    garments: Sequence[Garment | str] = DEFAULT_OUTFIT,
+    bone_names=None,
+    exact: bool = False,
+) -> Outfit:
     """Fit garments (Garment records or names/paths) on a human; see ``fitting.dress``."""
     loaded = [g if isinstance(g, Garment) else load_garment(g) for g in garments]
-    return fitting.dress(human, loaded, bone_names)
+    return fitting.dress(human, loaded, bone_names, exact)
 
 
 def parts(outfit: Outfit) -> list:
