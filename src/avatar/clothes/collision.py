@@ -14,6 +14,7 @@ closest-point-on-triangle regions).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -52,6 +53,20 @@ class BodySurface:
         n = self.incidence @ fn
         n /= np.maximum(np.sqrt(np.einsum("vd,vd->v", n, n))[:, None], 1e-12)
         return n
+
+    @cached_property
+    def neighbours(self) -> np.ndarray:
+        """(V, K) int32 each vertex and the vertices of its triangle ring, once each,
+        padded by repeating the vertex (a ring's corners hold each of them 2-3 times)."""
+        corners = np.sort(self.triangles[self.rings].reshape(len(self.rings), -1), axis=1)
+        first = np.ones(corners.shape, bool)
+        first[:, 1:] = corners[:, 1:] != corners[:, :-1]
+        width = int(first.sum(axis=1).max())
+        slot = np.cumsum(first, axis=1) - 1
+        out = np.repeat(np.arange(len(corners), dtype=np.int32)[:, None], width, axis=1)
+        rows = np.broadcast_to(np.arange(len(corners))[:, None], corners.shape)
+        out[rows[first], slot[first]] = corners[first]
+        return out
 
 
 def body_surface(faces: np.ndarray) -> BodySurface:

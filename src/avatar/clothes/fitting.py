@@ -192,8 +192,7 @@ class Pose:
         return points, q
 
     def _floor_at(self, vertex: np.ndarray) -> np.ndarray:
-        ring = self.surface.triangles[self.surface.rings[vertex]]  # (N, R, 3) neighbours
-        return self.floor[ring].reshape(len(vertex), -1).max(axis=1)
+        return self.floor[self.surface.neighbours[vertex]].max(axis=1)
 
     def _raise_floor(self, q: collision.SurfaceQuery, thickness: float) -> None:
         top = q.distance + np.float32(thickness)
