@@ -425,16 +425,17 @@ def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
     return extrude(points, q.normal, g.garment.thickness)
 
 
-def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple | None:
+def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple:
     """Rest-pose anchors of a garment for posed frames (see ``Outfit.anchors``); a shell's
-    outer layer gets its own (triangle, barycentrics, clearance)."""
+    outer layer gets its own (triangle, barycentrics, clearance). Returns (anchors or
+    None, the outer layer's anchored query or None)."""
     if q is None:
-        return None
+        return None, None
     tri, bary, near = garment.anchor_cache["inner"]
     inner = (tri, bary, pose.last_need, near)
     n = len(q.distance)
     if len(mesh.vertices) == n:
-        return inner
+        return inner, None
     outer = mesh.vertices[n:]
     if "outer" not in garment.anchor_cache:
         qo = pose.query_near(outer)
@@ -442,15 +443,14 @@ def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple | None:
     tri_o, bary_o, near_o = garment.anchor_cache["outer"]
     qo = collision.anchored(pose.vertices, pose.normals, pose.surface, outer, tri_o, bary_o)
     keep = np.minimum(qo.distance, pose.last_need + np.float32(garment.thickness))
-    return (*inner, tri_o, bary_o, np.maximum(keep, 0).astype(np.float32), near_o)
+    return (*inner, tri_o, bary_o, np.maximum(keep, 0).astype(np.float32), near_o), qo
 
 
-def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple) -> Mesh:
+def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo) -> Mesh:
     """A shell's outer layer, grown along the body normal, checked against the whole body
-    (in a fold it can reach the skin opposite)."""
+    (in a fold it can reach the skin opposite); qo: its anchored query (``_anchors``)."""
     n = len(anchor[2])
     outer = mesh.vertices[n:]
-    qo = collision.anchored(pose.vertices, pose.normals, pose.surface, outer, anchor[4], anchor[5])
     outer = fixed = collision.push_out(outer, qo, anchor[6])
     outer = remote_contacts(pose.surface, pose.vertices, pose.vertices, pose.normals, pose.tree,
                             outer, anchor[6], anchor[7], qo.normal, iterations=4)  # fmt: skip
@@ -525,9 +525,10 @@ def _dress(human, garments: list[Garment], bone_names) -> Outfit:
         )
         rests.append(inner)
         ws.append(w.limit(FRAME_INFLUENCES))
-        anchors.append(_anchors(pose, garment, q, mesh))
-        if anchors[-1] is not None and len(anchors[-1]) > 4:
-            mesh = _check_outer(pose, mesh, anchors[-1])
+        anchor, qo = _anchors(pose, garment, q, mesh)
+        anchors.append(anchor)
+        if qo is not None:
+            mesh = _check_outer(pose, mesh, anchor, qo)
             fitted[-1] = replace(fitted[-1], mesh=mesh)
     return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
 

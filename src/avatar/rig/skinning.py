@@ -54,10 +54,14 @@ class SkinWeights:
         """Keep the ``k`` largest influences per vertex, renormalised (for game engines)."""
         if self.weights.shape[1] <= k:
             return self
-        order = np.argsort(-self.weights, axis=1)[:, :k]
-        w = np.take_along_axis(self.weights, order, 1).astype(np.float64)
-        w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-12)
-        return SkinWeights(np.take_along_axis(self.indices, order, 1), w.astype(np.float32))
+        cache = self.__dict__.setdefault("_limited", {})  # a garment's weights serve every body
+        if k not in cache:
+            order = np.argsort(-self.weights, axis=1)[:, :k]
+            w = np.take_along_axis(self.weights, order, 1).astype(np.float64)
+            w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-12)
+            indices = np.take_along_axis(self.indices, order, 1)
+            cache[k] = SkinWeights(indices, w.astype(np.float32))
+        return cache[k]
 
     def subset(self, vertex_index: np.ndarray) -> SkinWeights:
         """Weights of the given vertices only."""
