@@ -299,11 +299,15 @@ class Outfit:
             rest, which moves with it, and is checked against other parts that come near.
         """
         out = self._frame_anchored(body_posed, matrices)
-        if not exact:
-            return out
-        skin = np.asarray(body_posed[:BODY_VERTEX_COUNT], dtype=np.float32)
+        return self._escape(body_posed, out) if exact else out
+
+    def _escape(self, body: np.ndarray, vertices: list[np.ndarray]) -> list[np.ndarray]:
+        """Each colliding garment's vertices (M_i, 3) with any inside the body (V, 3)
+        moved out of it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
+        skin = np.asarray(body[:BODY_VERTEX_COUNT], dtype=np.float32)
         tree = cKDTree(skin, balanced_tree=False, compact_nodes=False)
         normals = self.surface.normals(skin)
+        out = list(vertices)
         for i, (g, anchor) in enumerate(zip(self.garments, self.anchors, strict=True)):
             if anchor is not None:
                 need = _frame_need(g, anchor, len(out[i]))
@@ -480,19 +484,12 @@ def dress(human, garments: list[Garment], bone_names=None, exact: bool = False) 
 
 def _escape_rest(outfit: Outfit) -> Outfit:
     """The outfit with every garment vertex inside the rest body moved out of it."""
-    skin = outfit.rest_body
-    assert skin is not None  # _dress sets it
-    tree = cKDTree(skin, balanced_tree=False, compact_nodes=False)
-    normals = outfit.surface.normals(skin)
-    for i, (g, anchor) in enumerate(zip(outfit.garments, outfit.anchors, strict=True)):
-        if anchor is None:
+    assert outfit.rest_body is not None  # _dress sets it
+    rest = [g.mesh.vertices for g in outfit.garments]
+    for i, moved in enumerate(outfit._escape(outfit.rest_body, rest)):
+        if moved is rest[i] or np.array_equal(moved, rest[i]):
             continue
-        verts = g.mesh.vertices
-        need = _frame_need(g, anchor, len(verts))
-        moved = collision.escape(verts, skin, outfit.surface, need, tree, normals)
-        if np.array_equal(moved, verts):
-            continue
-        outfit.garments[i] = replace(g, mesh=g.mesh.with_vertices(moved))
+        outfit.garments[i] = replace(outfit.garments[i], mesh=outfit[i].mesh.with_vertices(moved))
         outfit.rest_surfaces[i] = moved[: len(outfit.rest_surfaces[i])]
     return outfit
 
