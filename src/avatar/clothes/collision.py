@@ -6,9 +6,9 @@ with the sign and push direction taken from the vertex normals interpolated at t
 (for a closest point on an edge or corner this matches the angle-weighted pseudo-normal's
 sign on every convex or concave feature, and gives a smooth push direction).
 
-Speed: candidate triangles are the one-rings of the k nearest body vertices found with a
-scipy cKDTree, then all candidates are tested at once with array maths (Ericson's
-closest-point-on-triangle regions).
+Speed: candidate triangles are the one-rings of the k nearest body vertices (a
+``nearest.PointTree``), then all candidates are tested at once with array maths on
+coordinate arrays (Ericson's closest-point-on-triangle regions).
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ from functools import cached_property
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.spatial import cKDTree
+
+from .nearest import PointTree
 
 
 @dataclass(frozen=True)
@@ -39,13 +40,15 @@ class BodySurface:
     def normals(self, vertices: np.ndarray) -> np.ndarray:
         """(V, 3) float32 unit area-weighted vertex normals of the body posed at vertices."""
         x = np.asarray(vertices, dtype=np.float32)
-        f = self.faces
+        c = self.face_corners
         # A polygon's area vector from its diagonals (for a quad this is exactly the sum of
         # its two triangles'): half the gathers of a per-triangle cross product.
-        if f.shape[1] == 4:
-            a, b = x[f[:, 2]] - x[f[:, 0]], x[f[:, 3]] - x[f[:, 1]]
+        if len(c) == 4:
+            a = np.take(x, c[2], axis=0) - np.take(x, c[0], axis=0)
+            b = np.take(x, c[3], axis=0) - np.take(x, c[1], axis=0)
         else:
-            a, b = x[f[:, 1]] - x[f[:, 0]], x[f[:, 2]] - x[f[:, 0]]
+            a = np.take(x, c[1], axis=0) - np.take(x, c[0], axis=0)
+            b = np.take(x, c[2], axis=0) - np.take(x, c[0], axis=0)
         fn = np.empty_like(a)
         fn[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
         fn[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
@@ -53,6 +56,16 @@ class BodySurface:
         n = self.incidence @ fn
         n /= np.maximum(np.sqrt(np.einsum("vd,vd->v", n, n))[:, None], 1e-12)
         return n
+
+    @cached_property
+    def face_corners(self) -> np.ndarray:
+        """(3|4, F) intp the faces' corners, one contiguous row per corner (fast gathers)."""
+        return np.ascontiguousarray(self.faces.T, dtype=np.intp)
+
+    @cached_property
+    def corners(self) -> np.ndarray:
+        """(3, T) intp the triangles' corners, one contiguous row per corner (fast gathers)."""
+        return np.ascontiguousarray(self.triangles.T, dtype=np.intp)
 
     @cached_property
     def neighbours(self) -> np.ndarray:
@@ -123,48 +136,162 @@ class SurfaceQuery:
 
 def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """(..., 3) barycentric weights of the closest point to p on triangles abc (all (..., 3))."""
-    ab, ac, ap = b - a, c - a, p - a
-    d1, d2 = _dot(ab, ap), _dot(ac, ap)
-    bp = p - b
-    d3, d4 = _dot(ab, bp), _dot(ac, bp)
-    cp = p - c
-    d5, d6 = _dot(ab, cp), _dot(ac, cp)
+    shape = np.broadcast_shapes(p.shape, a.shape, b.shape, c.shape)
+    p, a, b, c = (np.moveaxis(np.broadcast_to(v, shape), -1, 0) for v in (p, a, b, c))
+    return np.stack(closest_bary(p, a, b, c), axis=-1)
+
+
+def closest_bary(p, a, b, c) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Barycentric weights (u, v, w) of the closest points to p on triangles abc.
+
+    Each argument is a point's three coordinates (x, y, z), arrays that broadcast together:
+    Ericson's closest-point regions (5.1.5) on whole coordinate arrays, which numpy runs
+    several times faster than the same maths on (..., 3) arrays.
+    """
+    ab = [b[i] - a[i] for i in range(3)]
+    ac = [c[i] - a[i] for i in range(3)]
+    ap = [p[i] - a[i] for i in range(3)]
+    d1, d2 = _dot3(ab, ap), _dot3(ac, ap)
+    # With bp = ap - ab and cp = ap - ac, the other four dots need only three more products.
+    abab, acac, abac = _dot3(ab, ab), _dot3(ac, ac), _dot3(ab, ac)
+    d3, d4 = d1 - abab, d2 - abac
+    d5, d6 = d1 - abac, d2 - acac
     va = d3 * d6 - d5 * d4
     vb = d5 * d2 - d1 * d6
     vc = d1 * d4 - d3 * d2
-    # Interior by default, then overwrite with the edge and vertex regions (Ericson 5.1.5).
-    denom = va + vb + vc
-    denom = np.where(np.abs(denom) > 1e-30, denom, 1e-30)
+    # Interior by default, then overwritten by the edge and the corner regions.
+    denom = _nonzero(va + vb + vc)
     v, w = vb / denom, vc / denom
-    u = 1.0 - v - w
-    bary = np.stack([u, v, w], axis=-1)
-    bary = _edge(bary, (vc <= 0) & (d1 >= 0) & (d3 <= 0), d1, d1 - d3, 0, 1)
-    bary = _edge(bary, (vb <= 0) & (d2 >= 0) & (d6 <= 0), d2, d2 - d6, 0, 2)
-    bary = _edge(
-        bary, (va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), d4 - d3, (d4 - d3) + (d5 - d6), 1, 2
-    )
-    bary = _corner(bary, (d1 <= 0) & (d2 <= 0), 0)
-    bary = _corner(bary, (d3 >= 0) & (d4 <= d3), 1)
-    bary = _corner(bary, (d6 >= 0) & (d5 <= d6), 2)
-    return bary
+    uvw = (1.0 - v - w, v, w)
+    t = _fraction(d1, d1 - d3)
+    uvw = _where((vc <= 0) & (d1 >= 0) & (d3 <= 0), (1.0 - t, t, 0.0), uvw)  # edge ab
+    t = _fraction(d2, d2 - d6)
+    uvw = _where((vb <= 0) & (d2 >= 0) & (d6 <= 0), (1.0 - t, 0.0, t), uvw)  # edge ac
+    e, f = d4 - d3, d5 - d6
+    t = _fraction(e, e + f)
+    uvw = _where((va <= 0) & (e >= 0) & (f >= 0), (0.0, 1.0 - t, t), uvw)  # edge bc
+    uvw = _where((d1 <= 0) & (d2 <= 0), (1.0, 0.0, 0.0), uvw)  # corner a
+    uvw = _where((d3 >= 0) & (d4 <= d3), (0.0, 1.0, 0.0), uvw)  # corner b
+    return _where((d6 >= 0) & (d5 <= d6), (0.0, 0.0, 1.0), uvw)  # corner c
+
+
+def _fraction(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+    return np.clip(num / _nonzero(den), 0.0, 1.0)
+
+
+def _where(mask: np.ndarray, new: tuple, old: tuple) -> tuple:
+    return tuple(np.where(mask, n, o) for n, o in zip(new, old, strict=True))
+
+
+def _dot3(x, y) -> np.ndarray:
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+
+
+def _nonzero(x: np.ndarray) -> np.ndarray:
+    return np.where(np.abs(x) > 1e-30, x, 1e-30)
 
 
 def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", x, y)
 
 
-def _edge(bary, mask, num, den, i, j):
-    t = np.clip(num / np.where(np.abs(den) > 1e-30, den, 1e-30), 0.0, 1.0)
-    edge = np.zeros_like(bary)
-    edge[..., i] = 1.0 - t
-    edge[..., j] = t
-    return np.where(mask[..., None], edge, bary)
+class PosedBody:
+    """A body surface in one pose, laid out for a frame's searches: positions, vertex normals,
+    a k-d tree, and both as (3, V) coordinate rows (numpy gathers from a contiguous row
+    several times faster than rows of a (V, 3) array).
+
+    vertices: (V, 3) positions (m); normals, tree: reuse those already made for this pose.
+    """
+
+    def __init__(
+        self,
+        surface: BodySurface,
+        vertices: np.ndarray,
+        normals: np.ndarray | None = None,
+        tree: PointTree | None = None,
+    ):
+        self.surface = surface
+        self.vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+        self.normals = surface.normals(self.vertices) if normals is None else normals
+        if tree is not None:
+            self.__dict__["tree"] = tree
+
+    @cached_property
+    def tree(self) -> PointTree:
+        return PointTree(self.vertices)
+
+    @cached_property
+    def rows(self) -> np.ndarray:
+        """(3, V) float32 the vertices' x, y and z rows."""
+        return np.ascontiguousarray(self.vertices.T)
+
+    @cached_property
+    def normal_rows(self) -> np.ndarray:
+        """(3, V) float32 the normals' x, y and z rows."""
+        return np.ascontiguousarray(np.asarray(self.normals, dtype=np.float32).T)
+
+    def query(self, points: np.ndarray, k: int = 3) -> SurfaceQuery:
+        """Closest body points of points (N, 3): the triangle rings of each one's k nearest
+        vertices are all tested (more = exact further away)."""
+        p = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+        _, near = self.tree.query(p, k=k)
+        near = near.reshape(len(p), k)
+        rings = np.take(self.surface.rings, near, axis=0).reshape(len(p), -1)
+        cand = _unique_rows(rings)  # (N, C)
+        corner = np.take(self.surface.corners, cand, axis=1)  # (3, N, C) vertex indices
+        a, b, c = ([np.take(row, corner[j]) for row in self.rows] for j in range(3))
+        pc = [p[:, d, None] for d in range(3)]
+        bary = closest_bary(pc, a, b, c)
+        close = [bary[0] * a[d] + bary[1] * b[d] + bary[2] * c[d] for d in range(3)]
+        gap = [pc[d] - close[d] for d in range(3)]
+        best = np.argmin(_dot3(gap, gap), axis=1)
+        rows = np.arange(len(p))
+        bary = np.stack([w[rows, best] for w in bary], axis=1).astype(np.float32)
+        close = np.stack([w[rows, best] for w in close], axis=1).astype(np.float32)
+        triangle = cand[rows, best]
+        n = self._interpolated_normals(corner[:, rows, best], bary.T)
+        distance = np.sqrt(_dot3((p - close).T, (p - close).T))
+        distance = np.where(_dot3((p - close).T, n.T) < 0, -distance, distance)
+        return SurfaceQuery(distance.astype(np.float32), close, n, near[:, 0].astype(np.int32),
+                            triangle.astype(np.int32), bary)  # fmt: skip
+
+    def anchored(self, points: np.ndarray, triangle: np.ndarray, bary: np.ndarray) -> SurfaceQuery:
+        """Signed distances of points (N, 3) to known surface anchors (a triangle and
+        barycentric weights per point, e.g. the closest points found in the rest pose): no
+        search, O(N).
+
+        In a skinned pose the anchor moves with the skin under the point, which is where
+        its closest point stays unless another body part comes close; callers that need
+        those contacts too use ``query``.
+        """
+        corner = np.take(self.surface.corners, triangle, axis=1)  # (3, N)
+        weights = np.ascontiguousarray(np.asarray(bary, dtype=np.float32).T)
+        close = np.stack([_blend(row, corner, weights) for row in self.rows], axis=1)
+        n = self._interpolated_normals(corner, weights)
+        p = np.asarray(points, dtype=np.float32)
+        return SurfaceQuery(
+            distance=_dot3((p - close).T, n.T).astype(np.float32),
+            closest=close,
+            normal=n,
+            vertex=corner[0],
+            triangle=triangle,
+            bary=bary,
+        )
+
+    def _interpolated_normals(self, corner: np.ndarray, weights: np.ndarray) -> np.ndarray:
+        """(N, 3) unit normals blended from the vertex normals of corners (3, N)."""
+        n = [_blend(row, corner, weights) for row in self.normal_rows]
+        inverse = 1.0 / np.maximum(np.sqrt(_dot3(n, n)), 1e-12)
+        return np.stack([c * inverse for c in n], axis=1).astype(np.float32)
 
 
-def _corner(bary, mask, i):
-    corner = np.zeros_like(bary)
-    corner[..., i] = 1.0
-    return np.where(mask[..., None], corner, bary)
+def _blend(row: np.ndarray, corner: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(N,) one coordinate blended over triangle corners (3, N) with weights (3, N)."""
+    return (
+        np.take(row, corner[0]) * weights[0]
+        + np.take(row, corner[1]) * weights[1]
+        + np.take(row, corner[2]) * weights[2]
+    )
 
 
 def query(
@@ -172,45 +299,25 @@ def query(
     surface: BodySurface,
     points: np.ndarray,
     k: int = 3,
-    tree: cKDTree | None = None,
+    tree: PointTree | None = None,
     normals: np.ndarray | None = None,
 ) -> SurfaceQuery:
-    """Signed distances of points (N, 3) to the body (V, 3) (see SurfaceQuery).
+    """Signed distances of points (N, 3) to the body (V, 3) (see SurfaceQuery and
+    ``PosedBody.query``); tree, normals: reuse those already made for this pose."""
+    return PosedBody(surface, body_vertices, normals, tree).query(points, k)
 
-    k: nearest body vertices whose triangle rings are tested (more = exact further away).
-    tree, normals: reuse a cKDTree / (V, 3) vertex normals already built for this pose.
-    """
-    x = np.asarray(body_vertices, dtype=np.float32)
-    p = np.asarray(points, dtype=np.float32)
-    if tree is None:
-        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
-    if normals is None:
-        normals = surface.normals(x)
-    # Threads only pay off for big batches (a posed frame checks a few points).
-    _, near = tree.query(p, k=k, workers=-1 if len(p) > 20000 else 1)
-    near = near.reshape(len(p), k)
-    cand = surface.rings[near].reshape(len(p), -1)  # (N, C)
-    tri = surface.triangles[cand]  # (N, C, 3)
-    corners = x[tri]  # (N, C, 3, 3)
-    pc = p[:, None, :]
-    bary = closest_on_triangles(pc, corners[..., 0, :], corners[..., 1, :], corners[..., 2, :])
-    close = np.einsum("ncj,ncjd->ncd", bary, corners)
-    best = np.argmin(np.einsum("ncd,ncd->nc", pc - close, pc - close), axis=1)
-    rows = np.arange(len(p))
-    bary, tri_best, close = bary[rows, best], tri[rows, best], close[rows, best]
-    tri_index = cand[rows, best]
-    n = np.einsum("nj,njd->nd", bary, normals[tri_best])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-    gap = p - close
-    sign = np.where(_dot(gap, n) < 0, -1.0, 1.0)
-    return SurfaceQuery(
-        distance=(sign * np.linalg.norm(gap, axis=1)).astype(np.float32),
-        closest=close.astype(np.float32),
-        normal=n.astype(np.float32),
-        vertex=near[:, 0].astype(np.int32),
-        triangle=tri_index.astype(np.int32),
-        bary=bary.astype(np.float32),
-    )
+
+def _unique_rows(cand: np.ndarray) -> np.ndarray:
+    """(N, C') each row's distinct values (C' the most any row has; short rows repeat their
+    first): neighbouring vertices share most of their rings, so this halves the tests."""
+    cand = np.sort(cand, axis=1)
+    repeat = np.zeros(cand.shape, bool)
+    np.equal(cand[:, 1:], cand[:, :-1], out=repeat[:, 1:])
+    gone = np.iinfo(cand.dtype).max
+    cand[repeat] = gone
+    cand.sort(axis=1)  # the distinct values first
+    cand = cand[:, : cand.shape[1] - int(repeat.sum(axis=1).min())]
+    return np.where(cand == gone, cand[:, :1], cand)
 
 
 def anchored(
@@ -221,25 +328,8 @@ def anchored(
     triangle: np.ndarray,
     bary: np.ndarray,
 ) -> SurfaceQuery:
-    """Signed distances of points (N, 3) to known surface anchors (a triangle and barycentric
-    weights per point, e.g. the closest points found in the rest pose): no search, O(N).
-
-    In a skinned pose the anchor moves with the skin under the point, which is where its
-    closest point stays unless another body part comes close; callers that need those
-    contacts too use ``query``.
-    """
-    tri = surface.triangles[triangle]  # (N, 3)
-    close = np.einsum("nj,njd->nd", bary, body_vertices[tri])
-    n = np.einsum("nj,njd->nd", bary, normals[tri])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-    return SurfaceQuery(
-        distance=_dot(points - close, n).astype(np.float32),
-        closest=close.astype(np.float32),
-        normal=n.astype(np.float32),
-        vertex=tri[:, 0],
-        triangle=triangle,
-        bary=bary,
-    )
+    """``PosedBody.anchored`` on a body (V, 3) with its vertex normals (V, 3)."""
+    return PosedBody(surface, body_vertices, normals).anchored(points, triangle, bary)
 
 
 def penetration(
@@ -354,7 +444,7 @@ def escape(
     vertices: np.ndarray,
     surface: BodySurface,
     clearance: np.ndarray | float,
-    tree: cKDTree | None = None,
+    tree: PointTree | None = None,
     normals: np.ndarray | None = None,
 ) -> np.ndarray:
     """(N, 3) float32 points with every one inside the body moved out of it.
@@ -374,7 +464,7 @@ def escape(
     if len(inside) == 0:
         return out
     if tree is None:
-        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
+        tree = PointTree(x)
     if normals is None:
         normals = surface.normals(x)
     q = query(x, surface, out[inside], k=8, tree=tree, normals=normals)
@@ -394,6 +484,6 @@ def escape(
     if len(inside):  # deep in a part sunk into another (an arm into the chest): all skin
         lifted = x + need[inside].max() * normals
         free = np.flatnonzero(winding_number(lifted, x, surface.triangles) <= 0)
-        _, nearest = cKDTree(lifted[free]).query(out[inside])
+        _, nearest = PointTree(lifted[free]).query(out[inside])
         out[inside] = lifted[free[nearest]]
     return out

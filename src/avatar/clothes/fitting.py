@@ -15,7 +15,6 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property, lru_cache
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from avatar.clothes import collision, weights
 from avatar.clothes.binding import Binding, fit
@@ -28,7 +27,6 @@ from avatar.rig.skinning import SkinWeights, linear_blend
 BODY_VERTEX_COUNT = 13380  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
-THREADED = 4096  # points from which the k-d tree search runs on every core
 REMOTE_K = 3  # nearest skin vertices whose rest places tell another body part
 CLOSING = 0.01  # m that skin may come closer to a point's anchor before it is another part
 REMOTE_REACH = 0.06  # m; points further than this from every skin vertex are not checked
@@ -128,20 +126,13 @@ def body_surface(faces: np.ndarray) -> collision.BodySurface:
     return surface
 
 
-class Pose:
-    """One pose of the body as a collider: positions, vertex normals and a cKDTree."""
+class Pose(collision.PosedBody):
+    """One pose of the skin as a collider (``collision.PosedBody``) that also keeps the
+    layer floors of the garments fitted on it so far."""
 
     def __init__(self, surface: collision.BodySurface, vertices: np.ndarray):
-        self.surface = surface
-        self.vertices = np.asarray(vertices[:BODY_VERTEX_COUNT], dtype=np.float32)
-        self.normals = surface.normals(self.vertices)
-        self.tree = cKDTree(self.vertices, balanced_tree=False, compact_nodes=False)
+        super().__init__(surface, vertices[:BODY_VERTEX_COUNT])
         self.floor = np.zeros(BODY_VERTEX_COUNT, np.float32)
-
-    def query(self, points: np.ndarray, k: int = 1) -> collision.SurfaceQuery:
-        return collision.query(
-            self.vertices, self.surface, points, k=k, tree=self.tree, normals=self.normals
-        )
 
     def query_near(self, points: np.ndarray) -> collision.SurfaceQuery:
         """Closest skin of points: one vertex ring each, four rings near the skin.
@@ -177,16 +168,15 @@ class Pose:
         """``resolve`` against the garment's cached anchors: O(N) plus an exact search for
         the few points near another body part. Returns (points, query)."""
         tri, bary, near = garment.anchor_cache["inner"]
-        q = collision.anchored(self.vertices, self.normals, self.surface, points, tri, bary)
+        q = self.anchored(points, tri, bary)
         need = np.maximum(garment.clearance, self._floor_at(q.vertex) + LAYER_GAP)
         fitted = points
         pushed = collision.push_out(points, q, need)
-        points = remote_contacts(self.surface, self.vertices, self.vertices, self.normals,
-                                 self.tree, pushed, need, near, q.normal, 4)  # fmt: skip
+        points = remote_contacts(self, None, pushed, need, near, q.normal, 4)
         moved = np.flatnonzero(np.any(points != pushed, axis=1))
         if len(moved) and np.any(self.query(points[moved], k=4).distance < 0):
             return self.resolve(fitted, garment)  # squeezed between parts: the full search
-        q = collision.anchored(self.vertices, self.normals, self.surface, points, tri, bary)
+        q = self.anchored(points, tri, bary)
         self._raise_floor(q, garment.thickness)
         self.last_need = need.astype(np.float32)
         return points, q
@@ -285,6 +275,11 @@ class Outfit:
     def __getitem__(self, i: int) -> FittedGarment:
         return self.garments[i]
 
+    @cached_property
+    def rest_rows(self) -> np.ndarray:
+        """(3, 13380) float32 the rest skin's coordinate rows (``remote_contacts``)."""
+        return np.ascontiguousarray(np.asarray(self.rest_body, dtype=np.float32).T)
+
     def frame(
         self, body_posed: np.ndarray, matrices: np.ndarray, exact: bool = False
     ) -> list[np.ndarray]:
@@ -304,20 +299,17 @@ class Outfit:
     def _escape(self, body: np.ndarray, vertices: list[np.ndarray]) -> list[np.ndarray]:
         """Each colliding garment's vertices (M_i, 3) with any inside the body (V, 3)
         moved out of it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
-        skin = np.asarray(body[:BODY_VERTEX_COUNT], dtype=np.float32)
-        tree = cKDTree(skin, balanced_tree=False, compact_nodes=False)
-        normals = self.surface.normals(skin)
+        skin = collision.PosedBody(self.surface, body[:BODY_VERTEX_COUNT])
         out = list(vertices)
         for i, (g, anchor) in enumerate(zip(self.garments, self.anchors, strict=True)):
             if anchor is not None:
                 need = _frame_need(g, anchor, len(out[i]))
-                out[i] = collision.escape(out[i], skin, self.surface, need, tree, normals)
+                out[i] = collision.escape(out[i], skin.vertices, self.surface, need, skin.tree,
+                                          skin.normals)  # fmt: skip
         return out
 
     def _frame_anchored(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
-        x = np.asarray(body_posed[:BODY_VERTEX_COUNT], dtype=np.float32)
-        normals = self.surface.normals(x)
-        tree = cKDTree(x, balanced_tree=False, compact_nodes=False)
+        body = collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT])
         out, checks = [], []
         for g, rest, w, anchor in zip(
             self.garments, self.rest_surfaces, self.surface_weights, self.anchors, strict=True
@@ -326,12 +318,12 @@ class Outfit:
             if anchor is None:
                 out.append(points)
                 continue
-            q = collision.anchored(x, normals, self.surface, points, anchor[0], anchor[1])
+            q = body.anchored(points, anchor[0], anchor[1])
             points = _shell_frame(g, collision.push_out(points, q, anchor[2]), q)
             facing = q.normal
             if len(anchor) > 4:  # the outer layer keeps clear of the skin it is closest to
                 n = len(anchor[2])
-                qo = collision.anchored(x, normals, self.surface, points[n:], anchor[4], anchor[5])
+                qo = body.anchored(points[n:], anchor[4], anchor[5])
                 points[n:] = collision.push_out(points[n:], qo, anchor[6])
                 facing = np.concatenate([q.normal, qo.normal])
             # Both shell layers: where the body folds, the outer one can reach the next part.
@@ -344,11 +336,8 @@ class Outfit:
             index, need, near, facing = zip(*checks, strict=True)
             sizes = [len(out[i]) for i in index]
             joined = remote_contacts(
-                self.surface,
-                self.rest_body,
-                x,
-                normals,
-                tree,
+                body,
+                self.rest_rows,
                 np.concatenate([out[i] for i in index]),
                 np.concatenate(need),
                 np.concatenate(near),
@@ -369,42 +358,42 @@ def _frame_need(g: FittedGarment, anchor: tuple, count: int) -> np.ndarray:
     return need
 
 
-def remote_contacts(surface, reference, x, normals, tree, points, need, rest_near, facing,
-                    iterations: int = 1):  # fmt: skip
+def remote_contacts(body: collision.PosedBody, rest_rows: np.ndarray | None, points, need,
+                    rest_near, facing, iterations: int = 1):  # fmt: skip
     """Push points out of body parts other than the skin they are anchored to (an arm
     swinging into a shirt's side, one thigh into the other trouser leg). Such a point's
     nearest skin vertex now lies far, at rest, from its nearest one at rest; or one of
     its three nearest came closer to that one than it was at rest (skin pressing in,
     even where its vertex is not the nearest); or it faces another way than its anchor
     (a fold closing, as in the crotch). Only those few get the exact search."""
-    # All garments in one query, on every core: the largest single cost of a posed frame.
-    # At rest (reference is the body itself) no skin moved, so the nearest one tells all.
-    k = 1 if reference is x else REMOTE_K
-    workers = -1 if len(points) > THREADED else 1  # threads cost more than small batches
-    dist, near3 = tree.query(points, k=[*range(1, k + 1)], distance_upper_bound=REMOTE_REACH,
-                             workers=workers)  # fmt: skip
+    # All garments in one query: the largest single cost of a posed frame.
+    x, normals, tree = body.vertices, body.normals, body.tree
+    # At rest (no rest_rows: the body is at rest) no skin moved, so the nearest one tells all.
+    k = 1 if rest_rows is None else REMOTE_K
+    dist, near3 = tree.query(points, k=k, reach=REMOTE_REACH)
+    dist, near3 = dist.reshape(len(points), k), near3.reshape(len(points), k)
     close = np.isfinite(dist[:, 0])
     near3 = np.where(np.isfinite(dist), near3, near3[:, :1])
     far = np.flatnonzero(~close)
     if len(far):
         near3[far] = tree.query(points[far], k=1)[1][:, None]
     near = near3[:, 0]
-    rest_gap = np.linalg.norm(reference[near3] - reference[rest_near][:, None], axis=2)
-    gap = np.linalg.norm(x[near3] - x[rest_near][:, None], axis=2)
-    other = (rest_gap[:, 0] > REMOTE) | ((rest_gap - gap).max(axis=1) > CLOSING)
-    turned = np.einsum("nd,nd->n", normals[near], facing) < FOLD
+    other = _other_part(body.rows if rest_rows is None else rest_rows, body.rows, near3,
+                        rest_near)  # fmt: skip
+    normal = np.take(normals, near, axis=0)
+    turned = _dot_rows(normal, facing) < FOLD
     # The nearest vertex's tangent plane is a second, independent opinion: where it says
     # "too close" although the anchor did not, look properly. It also catches points far
     # from every skin vertex because they are deep inside another part (a skirt's hem
     # swept into the belly by a raised thigh), not far outside.
-    plane = np.einsum("nd,nd->n", points - x[near], normals[near]) < need - PLANE_SLACK
+    plane = _dot_rows(points - np.take(x, near, axis=0), normal) < need - PLANE_SLACK
     remote = np.flatnonzero((close & (other | turned)) | plane)
     if len(remote) == 0:
         return points
     points = points.copy()
     before = None
     for _ in range(iterations):
-        exact = collision.query(x, surface, points[remote], k=4, tree=tree, normals=normals)
+        exact = body.query(points[remote], k=4)
         short = exact.distance < need[remote] - 1e-5
         if not short.any():
             break
@@ -421,6 +410,29 @@ def remote_contacts(surface, reference, x, normals, tree, points, need, rest_nea
         before = exact
         points[remote] = moved
     return points
+
+
+def _other_part(rest_rows, rows, near3, rest_near) -> np.ndarray:
+    """(N,) bool: a point's nearest skin vertex lay far, at rest, from its anchor's vertex;
+    or one of its three nearest came closer to that vertex than it was at rest.
+    rest_rows, rows: (3, V) the skin's coordinate rows at rest and now."""
+    rest_gap = _distances(rest_rows, near3, rest_near)
+    gap = rest_gap if rows is rest_rows else _distances(rows, near3, rest_near)
+    return (rest_gap[:, 0] > REMOTE) | ((rest_gap - gap).max(axis=1) > CLOSING)
+
+
+def _distances(rows: np.ndarray, near: np.ndarray, anchor: np.ndarray) -> np.ndarray:
+    """(N, K) distances between the vertices ``near`` (N, K) and ``anchor`` (N,) of a
+    skin given by its coordinate rows (3, V)."""
+    square = np.zeros(near.shape, np.float32)
+    for row in rows:
+        d = np.take(row, near) - np.take(row, anchor)[:, None]
+        square += d * d
+    return np.sqrt(square)
+
+
+def _dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("nd,nd->n", a, b)
 
 
 def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
@@ -445,7 +457,7 @@ def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple:
         qo = pose.query_near(outer)
         garment.anchor_cache["outer"] = (qo.triangle, qo.bary, qo.vertex)
     tri_o, bary_o, near_o = garment.anchor_cache["outer"]
-    qo = collision.anchored(pose.vertices, pose.normals, pose.surface, outer, tri_o, bary_o)
+    qo = pose.anchored(outer, tri_o, bary_o)
     keep = np.minimum(qo.distance, pose.last_need + np.float32(garment.thickness))
     return (*inner, tri_o, bary_o, np.maximum(keep, 0).astype(np.float32), near_o), qo
 
@@ -456,8 +468,7 @@ def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo) -> Mesh:
     n = len(anchor[2])
     outer = mesh.vertices[n:]
     outer = fixed = collision.push_out(outer, qo, anchor[6])
-    outer = remote_contacts(pose.surface, pose.vertices, pose.vertices, pose.normals, pose.tree,
-                            outer, anchor[6], anchor[7], qo.normal, iterations=4)  # fmt: skip
+    outer = remote_contacts(pose, None, outer, anchor[6], anchor[7], qo.normal, 4)
     # Squeezed between two body parts there may be no room for the shell: it thins there.
     moved = np.flatnonzero(np.any(outer != fixed, axis=1))
     if len(moved):
