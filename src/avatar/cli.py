@@ -109,6 +109,13 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="glTF: include the 52 ARKit face units as morph targets",
     )
+    p.add_argument(
+        "--no-resolve-garments",
+        dest="resolve_garments",
+        action="store_false",
+        help="glTF: skin garments plainly instead of baking each frame's penetration "
+        "resolve into morph targets (faster, smaller; garments may clip into the body)",
+    )
     p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
     p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")
     p.set_defaults(run=run_create)
@@ -214,7 +221,7 @@ def run_create(args: argparse.Namespace) -> int:
     human = _dress(human, args.wear)
     animation, name = _animation(human, args)
     path = save(human, args.output, animation, args.expressions, args.hide_covered, name,
-                args.rest)  # fmt: skip
+                args.rest, resolve_garments=args.resolve_garments, progress=True)  # fmt: skip
     log.info("wrote %s", path)
     if args.render:
         from avatar.blender.picture import render_human

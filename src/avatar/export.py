@@ -33,8 +33,15 @@ def _gltf(human: Human, path: Path, animation: Animation | None, options: dict) 
 
     options = dict(options)
     name = options.pop("animation_name", None) or "animation"
+    resolve, progress = options.pop("resolve_garments", True), options.pop("progress", False)
     clips = {name: animation} if animation is not None else {}
-    gltf.write(path, human.parts(**options), human.skeleton, clips)
+    parts, keyed = human.parts(**options), {}
+    if resolve and animation is not None and human.recipe.clothes:
+        from avatar.clothes import bake
+
+        parts, weights = bake.bake(human, animation, parts, progress)
+        keyed = {name: weights}
+    gltf.write(path, parts, human.skeleton, clips, morph_weights=keyed)
 
 
 def _bvh(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
@@ -79,6 +86,8 @@ def save(
     hide_covered: bool = False,
     animation_name: str | None = None,
     rest: str | None = None,
+    resolve_garments: bool = True,
+    progress: bool = False,
 ) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
@@ -88,6 +97,11 @@ def save(
         "animation"); players and Blender's importer show it as the clip/action name.
     rest: BVH only: write the skeleton resting in this pose ("t-pose", "a-pose", a pose
         file) with the motion re-expressed on it (``poselib.switch_rest``).
+    resolve_garments: glTF with garments and an animation: bake each frame's penetration
+        resolve (``Outfit.frame(..., exact=True)``) into one morph target per frame,
+        switched on by a weights channel, so viewers show no garment inside the body
+        (``avatar.clothes.bake``; ~0.1-0.3 s a frame). False: plain skinned garments.
+    progress: show a progress bar over long work (the garment bake).
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
     (the skin mesh), .mhm (MakeHuman character file), .bvh (the skeleton and its motion,
     or its rest pose), .fbx/.usd/.blend (through Blender).
@@ -99,6 +113,8 @@ def save(
     path.parent.mkdir(parents=True, exist_ok=True)
     options = {"expressions": expressions, "hide_covered": hide_covered,
                "animation_name": animation_name}  # fmt: skip
+    if path.suffix.lower() in (".glb", ".gltf"):
+        options |= {"resolve_garments": resolve_garments, "progress": progress}
     if rest:
         options["rest"] = rest
     writer(human, path, animation, options)

@@ -20,6 +20,7 @@ original vertex array, skin and morphs exactly.
 from __future__ import annotations
 
 import base64
+import contextlib
 import logging
 import os
 from collections.abc import Mapping, Sequence
@@ -31,7 +32,7 @@ import pygltflib as g
 
 from avatar.errors import FormatError
 from avatar.io import gltf_accessors as acc
-from avatar.io import gltf_materials, gltf_skin
+from avatar.io import gltf_materials, gltf_morphs, gltf_skin
 from avatar.mesh import Mesh, vertex_normals
 from avatar.part import MeshPart
 from avatar.rig.skeleton import Animation, Skeleton
@@ -44,11 +45,13 @@ VERTEX_ID = "_AVATAR_VERTEX"
 
 @dataclass(frozen=True)
 class GltfFile:
-    """What ``read`` returns: the parts, the skeleton (or None) and the animations by name."""
+    """What ``read`` returns: the parts, the skeleton (or None), the animations by name, and
+    animation name -> part name -> (T, targets) keyed morph weights (``weights`` channels)."""
 
     parts: list[MeshPart]
     skeleton: Skeleton | None = None
     animations: dict[str, Animation] = field(default_factory=dict)
+    morph_weights: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
 
 def write(
@@ -57,6 +60,7 @@ def write(
     skeleton: Skeleton | None = None,
     animations: Sequence[Animation] | Mapping[str, Animation] = (),
     *,
+    morph_weights: Mapping[str, Mapping[str, np.ndarray]] | None = None,
     embed: bool = False,
     vertex_ids: bool = True,
     generator: str = "Avatar",
@@ -66,6 +70,9 @@ def write(
     parts: the meshes; a part with ``skin`` is bound to ``skeleton`` (required then).
     animations: Animation records (named ``animation_<i>``) or a name -> Animation mapping;
         their bone names must exist in ``skeleton``. Key times are ``frame / fps``.
+    morph_weights: animation name -> part name -> (frames, targets) weights of that part's
+        morph targets (in ``part.morphs`` order), keyed with STEP interpolation in that
+        animation (e.g. per-frame garment corrections, ``avatar.clothes.bake``).
     embed: for ``.gltf``, put the buffer in a data URI instead of a side-car ``.bin``.
     vertex_ids: write ``_AVATAR_VERTEX`` so ``read`` can merge seam vertices back.
     """
@@ -87,25 +94,42 @@ def write(
         for name, animation in named.items():
             gltf_skin.add_animation(gltf, packer, skeleton, animation, name)
     materials = gltf_materials.Materials(gltf, packer)
+    nodes = {}
     for part in parts:
-        _add_part(gltf, packer, part, materials, skin_index, vertex_ids)
+        nodes[part.name] = _add_part(gltf, packer, part, materials, skin_index, vertex_ids)
+    gltf_morphs.add_channels(gltf, packer, list(named), nodes, morph_weights or {})
     _save(gltf, bytes(packer.blob), path, embed)
 
 
 def _save(gltf: g.GLTF2, blob: bytes, path: Path, embed: bool) -> None:
-    """Attach the buffer and write the file in the container the suffix names."""
+    """Attach the buffer and write the file in the container the suffix names.
+
+    Each file is written beside its final name and renamed into place, so an interrupted
+    or failed write never leaves a truncated file (or replaces a good one).
+    """
     buffer = g.Buffer(byteLength=len(blob))
     gltf.buffers.append(buffer)
     if path.suffix.lower() == ".glb":
         gltf.set_binary_blob(blob)
-        gltf.save_binary(str(path))
+        _atomic(path, lambda tmp: gltf.save_binary(str(tmp)))
         return
     if embed:
         buffer.uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode()
     else:
         buffer.uri = path.with_suffix(".bin").name
-        path.with_suffix(".bin").write_bytes(blob)
-    gltf.save_json(str(path))
+        _atomic(path.with_suffix(".bin"), lambda tmp: tmp.write_bytes(blob))
+    _atomic(path, lambda tmp: tmp.write_text(gltf.gltf_to_json()))
+
+
+def _atomic(path: Path, write) -> None:
+    """Call ``write(tmp)`` on a temporary path in ``path``'s folder, then rename it to ``path``."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
 
 
 # ---------------------------------------------------------------------------- geometry
@@ -139,8 +163,8 @@ def _triangulate(faces: np.ndarray, face_uvs: np.ndarray | None):
     return tris[keep], (None if uvs is None else uvs[keep])
 
 
-def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: bool) -> None:
-    """One part -> one mesh with one primitive, and a node at the scene root."""
+def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: bool) -> int:
+    """One part -> one mesh with one primitive, and a node at the scene root (its index)."""
     mesh = part.mesh
     source, uv_index, triangles = split_vertices(mesh)
     normals = (
@@ -181,6 +205,7 @@ def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: b
     node = g.Node(name=part.name, mesh=len(gltf.meshes) - 1, skin=skin_index if part.skin else None)
     gltf.nodes.append(node)
     gltf.scenes[0].nodes.append(len(gltf.nodes) - 1)
+    return len(gltf.nodes) - 1
 
 
 def _add_skin_attributes(attributes, packer, skin, source, joint_count: int) -> None:
@@ -254,7 +279,8 @@ def read(path: str | os.PathLike[str]) -> GltfFile:
     """Read a glTF/GLB file written by Avatar (or any file using the same features).
 
     Returns parts in Avatar's frame (triangles; UVs per corner; vertices merged back through
-    ``_AVATAR_VERTEX`` when present), the skin's skeleton and every animation.
+    ``_AVATAR_VERTEX`` when present), the skin's skeleton, every animation and the morph
+    weights keyed in them (by part name).
     Raises FormatError on unreadable files.
     """
     path = Path(path)
@@ -269,9 +295,20 @@ def read(path: str | os.PathLike[str]) -> GltfFile:
         skeleton, joint_nodes = gltf_skin.read_skeleton(gltf, buffers)
         parts = [_read_part(gltf, buffers, node, joint_nodes) for node in _scene_mesh_nodes(gltf)]
         animations = gltf_skin.read_animations(gltf, buffers, skeleton, joint_nodes)
+        keyed = gltf_morphs.read_weights(gltf, buffers)
     except (IndexError, KeyError, ValueError, TypeError, OSError) as exc:
         raise FormatError(path, 0, f"invalid glTF content: {exc}") from None
-    return GltfFile([p for group in parts for p in group], skeleton, animations)
+    morph_weights = {
+        clip: {_node_name(gltf, n): w for n, w in by_node.items()}
+        for clip, by_node in keyed.items()
+    }
+    return GltfFile([p for group in parts for p in group], skeleton, animations, morph_weights)
+
+
+def _node_name(gltf: g.GLTF2, n: int) -> str:
+    """The part name ``_read_part`` gives a mesh node's (first) primitive."""
+    node = gltf.nodes[n]
+    return node.name or gltf.meshes[node.mesh].name or f"mesh_{node.mesh}"
 
 
 def _scene_mesh_nodes(gltf: g.GLTF2) -> list[int]:

@@ -59,19 +59,24 @@ class Packer:
             accessor.max = flat.max(axis=0).tolist()
         return self._add(accessor)
 
-    def sparse_accessor(self, values: np.ndarray) -> int:
-        """(N, 3) float32 mostly-zero deltas -> a sparse accessor over implicit zeros.
+    def sparse_accessor(self, values: np.ndarray, target: int | None = ARRAY_BUFFER) -> int:
+        """(N,) or (N, C) float32 mostly-zero values -> a sparse accessor over implicit zeros.
 
-        Falls back to a dense accessor when more than a third of the rows are non-zero
-        (sparse storage would be larger). min/max always cover all N rows.
+        Used for morph target deltas (N, 3) and for morph weight animation outputs (one
+        weight set per key, flattened). Falls back to a dense accessor (bound to ``target``)
+        when more than a third of the rows are non-zero (sparse storage would be larger).
+        min/max always cover all N rows.
         """
         values = np.ascontiguousarray(values, dtype=np.float32)
-        nonzero = np.flatnonzero(np.any(values != 0, axis=1))
+        rows = values.reshape(len(values), -1)
+        nonzero = np.flatnonzero(np.any(rows != 0, axis=1))
         if len(nonzero) * 3 > len(values):
-            return self.accessor(values, ARRAY_BUFFER, bounds=True)
-        accessor = g.Accessor(componentType=5126, count=len(values), type="VEC3", byteOffset=None)
-        accessor.min = np.minimum(values.min(axis=0), 0).tolist()
-        accessor.max = np.maximum(values.max(axis=0), 0).tolist()
+            return self.accessor(values, target, bounds=True)
+        accessor = g.Accessor(
+            componentType=5126, count=len(values), type=TYPE_OF[rows.shape[1]], byteOffset=None
+        )
+        accessor.min = np.minimum(rows.min(axis=0, initial=0), 0).tolist()
+        accessor.max = np.maximum(rows.max(axis=0, initial=0), 0).tolist()
         if len(nonzero):
             index_type = np.dtype("<u2") if len(values) <= 65536 else np.dtype("<u4")
             accessor.sparse = g.Sparse(
@@ -80,7 +85,7 @@ class Packer:
                     bufferView=self.view(nonzero.astype(index_type).tobytes()),
                     componentType=COMPONENT_OF[index_type],
                 ),
-                values=g.AccessorSparseValues(bufferView=self.view(values[nonzero].tobytes())),
+                values=g.AccessorSparseValues(bufferView=self.view(rows[nonzero].tobytes())),
             )
         return self._add(accessor)
 
