@@ -43,3 +43,19 @@ def test_info_lists_parameters(capsys, model):
     assert cli.main(["info", "--search", "pca/"]) == 0
     out = capsys.readouterr().out
     assert out.count("pca/") == 7
+
+
+@pytest.mark.parametrize(("flags", "resolve"), [([], True), (["--no-resolve-garments"], False)])
+def test_create_resolves_garments_in_animations_unless_told_not_to(tmp_path, model, monkeypatch,
+                                                                   flags, resolve):  # fmt: skip
+    """Dressed + animated glTF bakes the garment resolve by default, with a progress bar."""
+    import avatar.export
+
+    calls = []
+    monkeypatch.setattr(avatar.export, "save", lambda *a, **k: calls.append((a, k)) or a[1])
+    argv = ["create", "--wear", "tshirt", "--motion", "walk", "--fps", "4",
+            "-o", str(tmp_path / "w.glb"), *flags]  # fmt: skip
+    assert cli.main(argv) == 0
+    ((args, kwargs),) = calls
+    assert kwargs["resolve_garments"] is resolve and kwargs["progress"] is True
+    assert args[0].recipe.clothes == ("tshirt",) and args[2].frames == 8

@@ -240,3 +240,41 @@ def test_khronos_validator_reports_no_issue(tmp_path, name):
                           capture_output=True, text=True, check=True, timeout=120)  # fmt: skip
     issues = json.loads(done.stdout)["issues"]
     assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
+
+
+def test_keyed_morph_weights_round_trip_and_validate(tmp_path):
+    """A ``weights`` channel (STEP, sparse output) is read back per part; bad shapes fail."""
+    parts, sk, anim = scene()
+    weights = np.zeros((anim.frames, 3), dtype=np.float32)
+    weights[1, 0], weights[-1, 1] = 1.0, 0.25
+    path = tmp_path / "t.glb"
+    gltf.write(path, parts, sk, {"bend": anim}, morph_weights={"bend": {"limb": weights}})
+    back = gltf.read(path)
+    np.testing.assert_array_equal(back.morph_weights["bend"]["limb"], weights)
+    assert "crate" not in back.morph_weights["bend"]
+    if _validator() is not None:
+        done = subprocess.run(["node", str(HERE / "validate_gltf.cjs"), str(_validator()),
+                               str(path)], capture_output=True, text=True, check=True)  # fmt: skip
+        issues = json.loads(done.stdout)["issues"]
+        assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
+    for bad in ({"bend": {"limb": weights[:, :2]}}, {"bend": {"nope": weights}},
+                {"walk": {"limb": weights}}):  # fmt: skip
+        with pytest.raises(ValueError):
+            gltf.write(tmp_path / "bad.glb", parts, sk, {"bend": anim}, morph_weights=bad)
+    assert not (tmp_path / "bad.glb").exists()
+
+
+@pytest.mark.parametrize("name", SUFFIXES)
+def test_interrupted_write_leaves_the_old_file_and_no_partial_one(tmp_path, name, monkeypatch):
+    parts, sk, anim = scene()
+    _write(tmp_path, name, parts, sk, {"bend": anim})
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pygltflib.GLTF2, "save_to_bytes", interrupt)
+    monkeypatch.setattr(pygltflib.GLTF2, "gltf_to_json", interrupt)
+    with pytest.raises(KeyboardInterrupt):  # a different file, interrupted while saving
+        _write(tmp_path, name, parts[1:], sk, {"bend": anim})
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

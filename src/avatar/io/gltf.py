@@ -23,7 +23,7 @@ import base64
 import contextlib
 import logging
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -111,25 +111,30 @@ def _save(gltf: g.GLTF2, blob: bytes, path: Path, embed: bool) -> None:
     gltf.buffers.append(buffer)
     if path.suffix.lower() == ".glb":
         gltf.set_binary_blob(blob)
-        _atomic(path, lambda tmp: gltf.save_binary(str(tmp)))
+        _atomic({path: lambda tmp: gltf.save_binary(str(tmp))})
         return
     if embed:
         buffer.uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode()
-    else:
-        buffer.uri = path.with_suffix(".bin").name
-        _atomic(path.with_suffix(".bin"), lambda tmp: tmp.write_bytes(blob))
-    _atomic(path, lambda tmp: tmp.write_text(gltf.gltf_to_json()))
+        _atomic({path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})
+        return
+    buffer.uri = path.with_suffix(".bin").name
+    _atomic({path.with_suffix(".bin"): lambda tmp: tmp.write_bytes(blob),
+             path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})  # fmt: skip
 
 
-def _atomic(path: Path, write) -> None:
-    """Call ``write(tmp)`` on a temporary path in ``path``'s folder, then rename it to ``path``."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
+def _atomic(writers: dict[Path, Callable[[Path], object]]) -> None:
+    """Call each ``write(tmp)`` on a temporary path beside its file, then rename them all
+    into place: nothing is replaced unless every file was written."""
+    temps = {path: path.with_name(f".{path.name}.{os.getpid()}.part") for path in writers}
     try:
-        write(tmp)
-        os.replace(tmp, path)
+        for path, write in writers.items():
+            write(temps[path])
+        for path, tmp in temps.items():
+            os.replace(tmp, path)
     finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp.unlink()
+        for tmp in temps.values():
+            with contextlib.suppress(FileNotFoundError):
+                tmp.unlink()
 
 
 # ---------------------------------------------------------------------------- geometry
