@@ -209,16 +209,20 @@ class PosedBody:
         vertices: np.ndarray,
         normals: np.ndarray | None = None,
         tree: PointTree | None = None,
+        tree_now: bool = False,
     ):
+        """tree_now: start building the k-d tree at once, on a background thread, while the
+        caller goes on (for a caller that will search)."""
         self.surface = surface
         self.vertices = np.ascontiguousarray(vertices, dtype=np.float32)
+        self._tree = tree if tree is not None or not tree_now else PointTree.later(self.vertices)
         self.normals = surface.normals(self.vertices) if normals is None else normals
-        if tree is not None:
-            self.__dict__["tree"] = tree
 
     @cached_property
     def tree(self) -> PointTree:
-        return PointTree(self.vertices)
+        if self._tree is None:
+            return PointTree(self.vertices)
+        return self._tree if isinstance(self._tree, PointTree) else self._tree.result()
 
     @cached_property
     def rows(self) -> np.ndarray:

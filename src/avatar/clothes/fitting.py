@@ -131,7 +131,7 @@ class Pose(collision.PosedBody):
     layer floors of the garments fitted on it so far."""
 
     def __init__(self, surface: collision.BodySurface, vertices: np.ndarray):
-        super().__init__(surface, vertices[:BODY_VERTEX_COUNT])
+        super().__init__(surface, vertices[:BODY_VERTEX_COUNT], tree_now=True)
         self.floor = np.zeros(BODY_VERTEX_COUNT, np.float32)
 
     def query_near(self, points: np.ndarray) -> collision.SurfaceQuery:
@@ -299,7 +299,7 @@ class Outfit:
     def _escape(self, body: np.ndarray, vertices: list[np.ndarray]) -> list[np.ndarray]:
         """Each colliding garment's vertices (M_i, 3) with any inside the body (V, 3)
         moved out of it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
-        skin = collision.PosedBody(self.surface, body[:BODY_VERTEX_COUNT])
+        skin = collision.PosedBody(self.surface, body[:BODY_VERTEX_COUNT], tree_now=True)
         out = list(vertices)
         for i, (g, anchor) in enumerate(zip(self.garments, self.anchors, strict=True)):
             if anchor is not None:
@@ -309,7 +309,7 @@ class Outfit:
         return out
 
     def _frame_anchored(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
-        body = collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT])
+        body = collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT], tree_now=True)
         out, checks = [], []
         for g, rest, w, anchor in zip(
             self.garments, self.rest_surfaces, self.surface_weights, self.anchors, strict=True

@@ -8,8 +8,13 @@ skin vertices, a few hundred to ten thousand queries; see docs/benchmarks.md).
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import Future, ThreadPoolExecutor
+
 import numpy as np
 from pykdtree.kdtree import KDTree
+
+_BUILDER: list = []  # [(pid, executor)]: a forked child makes its own thread
 
 
 class PointTree:
@@ -18,6 +23,15 @@ class PointTree:
     def __init__(self, points: np.ndarray):
         self.points = np.ascontiguousarray(points, dtype=np.float32)
         self._tree = KDTree(self.points, leafsize=16)
+
+    @classmethod
+    def later(cls, points: np.ndarray) -> Future[PointTree]:
+        """A tree built on a background thread (the build runs without the GIL), for a
+        caller with other work to do before its first search."""
+        points = np.array(points, dtype=np.float32)  # the caller may reuse its array
+        if not _BUILDER or _BUILDER[0][0] != os.getpid():
+            _BUILDER[:] = [(os.getpid(), ThreadPoolExecutor(1, "avatar-kdtree"))]
+        return _BUILDER[0][1].submit(cls, points)
 
     def __len__(self) -> int:
         return len(self.points)
