@@ -30,6 +30,7 @@ from avatar.rig.skeleton import Animation
 log = logging.getLogger(__name__)
 
 TOLERANCE = 5e-5  # m; smaller corrections are left out (the target stays sparse)
+CHUNK = 256  # frames whose bone matrices are computed together
 SINGULAR = 1e-6  # |det A| below which a vertex's blended matrix is inverted by pseudo-inverse
 
 
@@ -126,11 +127,21 @@ def _frames(human, animation: Animation, progress: bool):
     """(t, body (V, 3), skinning matrices (J, 4, 4)) for every frame of the animation."""
     from tqdm import tqdm
 
-    world = kinematics.forward(human.skeleton, animation.rotations, animation.translations)
-    matrices = kinematics.skinning_matrices(human.skeleton, world)
-    for t in tqdm(range(animation.frames), desc="resolving garments", unit="frame",
-                  disable=not progress, leave=False):  # fmt: skip
-        yield t, skinning.linear_blend(human.vertices, human.weights, matrices[t]), matrices[t]
+    bar = tqdm(total=animation.frames, desc="resolving garments", unit="frame",
+               disable=not progress, leave=False)  # fmt: skip
+    with bar:
+        for start in range(0, animation.frames, CHUNK):  # bounded memory on long clips
+            rows = slice(start, start + CHUNK)
+            world = kinematics.forward(
+                human.skeleton, animation.rotations[rows], animation.translations[rows]
+            )
+            for k, matrices in enumerate(kinematics.skinning_matrices(human.skeleton, world)):
+                yield (
+                    start + k,
+                    skinning.linear_blend(human.vertices, human.weights, matrices),
+                    matrices,
+                )
+                bar.update()
 
 
 def _with_targets(
