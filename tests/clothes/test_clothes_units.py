@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from avatar.clothes import binding, collision, fabrics, shell, weights
+from avatar.clothes import binding, collision, fabrics, nearest, shell, weights
 from avatar.clothes.binder import bind, save
 from avatar.clothes.scan import scan
 from avatar.errors import AvatarError, FormatError
@@ -70,6 +70,50 @@ def test_winding_number_counts_overlapping_solids():
     known = collision.winding_number(np.array([[1.5, 1, 0.75], [0.5, 0.5, 0.5], [-0.5] * 3,
                                                [2.2, 0, 0]]), vertices, triangles)  # fmt: skip
     assert known.tolist() == [1, 2, 1, 0]
+
+
+def test_closest_points_on_triangles_match_dense_sampling():
+    """The closest point found on each random triangle is as close as the best of 5,151
+    points sampled over it, and no sample is closer (within the sampling step)."""
+    rng = np.random.default_rng(1)
+    a, b, c, p = (rng.normal(size=(300, 3)) for _ in range(4))
+    c[:20] = a[:20] + 0.5 * (b[:20] - a[:20])  # degenerate: all three on one line
+    bary = collision.closest_on_triangles(p, a, b, c)
+    assert np.all(bary >= -1e-9) and np.allclose(bary.sum(axis=1), 1)
+    got = np.linalg.norm(p - (bary[:, :1] * a + bary[:, 1:2] * b + bary[:, 2:] * c), axis=1)
+    u, v = (w.ravel() for w in np.meshgrid(np.linspace(0, 1, 101), np.linspace(0, 1, 101)))
+    u, v = u[u + v <= 1], v[u + v <= 1]
+    samples = (a[:, None] + u[None, :, None] * (b - a)[:, None]
+               + v[None, :, None] * (c - a)[:, None])  # fmt: skip
+    sampled = np.linalg.norm(samples - p[:, None], axis=2).min(axis=1)
+    edge = np.maximum.reduce([np.linalg.norm(x - y, axis=1) for x, y in ((a, b), (b, c), (c, a))])
+    assert np.all(got <= sampled + 1e-9)
+    assert np.all(sampled - got <= edge * 0.02 + 1e-9)  # a sample lies within 0.02 edge
+
+
+def test_point_tree_finds_the_nearest_points_within_reach():
+    rng = np.random.default_rng(3)
+    data, points = rng.random((500, 3)), rng.random((200, 3))
+    tree = nearest.PointTree(data)
+    dist, index = tree.query(points, k=3, reach=0.08)
+    brute = np.linalg.norm(points[:, None] - data[None], axis=2)
+    order = np.sort(brute, axis=1)[:, :3]
+    found = np.isfinite(dist)
+    assert np.array_equal(found, order < 0.08)
+    assert np.allclose(dist[found], order[found], atol=1e-6)
+    assert np.all(index[~found] == len(tree))
+    one, _ = tree.query(points)
+    assert one.shape == (200,) and np.allclose(one, order[:, 0], atol=1e-6)
+
+
+def test_a_winding_grid_serves_many_queries_of_one_surface():
+    tris = np.concatenate([CUBE.faces[:, [0, 1, 2]], CUBE.faces[:, [0, 2, 3]]])
+    grid = collision.WindingGrid(CUBE.vertices, tris, cell=0.25)
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        points = rng.uniform(-1.5, 1.5, (500, 3))
+        inside = np.all(np.abs(points) < 1, axis=1)
+        assert np.array_equal(grid.winding(points), inside.astype(int))
 
 
 def test_surface_distance_is_exact_on_a_cube():

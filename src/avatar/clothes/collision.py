@@ -357,61 +357,72 @@ def winding_number(
     """(N,) int winding number of a closed, outward-oriented triangle surface at points.
 
     1 inside, 0 outside, and 2 where a skinned body passes into itself: unlike a
-    closest-point sign it stays right where the surface self-intersects. Counted along a
-    ray going up from each point: +1 for each crossing of an upward-facing triangle
-    (leaving), -1 for a downward-facing one (entering). Only the triangles over the
-    point's ``cell`` (m) of an xy grid are tested.
+    closest-point sign it stays right where the surface self-intersects. See
+    ``WindingGrid``, which also serves many queries of one surface.
     """
-    x = np.asarray(vertices, dtype=np.float64)
-    c = x[np.asarray(triangles)]  # (T, 3, 3)
-    # A fixed irrational nudge keeps rays off the shared edges of axis-aligned data.
-    p = np.asarray(points, dtype=np.float64) + np.array([1.1e-7, 0.7e-7, 0.0])
-    pair_point, pair_tri = _column_pairs(p[:, :2], c[..., :2], cell)
-    a, b, d = c[pair_tri, 0], c[pair_tri, 1], c[pair_tri, 2]
-    # Barycentrics of the point's xy in the triangle's xy projection.
-    e1, e2, r = b[:, :2] - a[:, :2], d[:, :2] - a[:, :2], p[pair_point, :2] - a[:, :2]
-    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    safe = np.where(det != 0, det, 1.0)
-    v = (r[:, 0] * e2[:, 1] - r[:, 1] * e2[:, 0]) / safe
-    w = (e1[:, 0] * r[:, 1] - e1[:, 1] * r[:, 0]) / safe
-    hit = (det != 0) & (v >= 0) & (w >= 0) & (v + w <= 1)
-    z = a[:, 2] + v * (b[:, 2] - a[:, 2]) + w * (d[:, 2] - a[:, 2])
-    hit &= z > p[pair_point, 2]
-    return (
-        np.bincount(pair_point[hit], weights=np.sign(det[hit]), minlength=len(p))
-        .round()
-        .astype(np.int64)
-    )
+    return WindingGrid(vertices, triangles, cell).winding(points)
 
 
-def _column_pairs(
-    points_xy: np.ndarray, triangles_xy: np.ndarray, cell: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """(point, triangle) index pairs whose xy grid cells meet: each triangle is filed
-    under every cell its xy bounding box touches, each point looks in its own cell."""
-    lo, hi = triangles_xy.min(axis=1), triangles_xy.max(axis=1)
-    origin = lo.min(axis=0)
-    i0 = np.floor((lo - origin) / cell).astype(np.int64)
-    i1 = np.floor((hi - origin) / cell).astype(np.int64)
-    rows = int(i1[:, 1].max()) + 1
-    span = i1 - i0 + 1
-    count = span[:, 0] * span[:, 1]
-    tri = np.repeat(np.arange(len(triangles_xy)), count)
-    k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
-    cx = i0[tri, 0] + k % span[tri, 0]
-    cy = i0[tri, 1] + k // span[tri, 0]
-    cells = cx * rows + cy
-    order = np.argsort(cells, kind="stable")
-    cells, tri = cells[order], tri[order]
-    pc = np.floor((points_xy - origin) / cell).astype(np.int64)
-    valid = (pc[:, 0] >= 0) & (pc[:, 1] >= 0) & (pc[:, 1] < rows)
-    key = np.where(valid, pc[:, 0] * rows + pc[:, 1], -1)
-    start = np.searchsorted(cells, key, "left")
-    stop = np.where(valid, np.searchsorted(cells, key, "right"), start)
-    n = stop - start
-    pair_point = np.repeat(np.arange(len(points_xy)), n)
-    pair_tri = tri[np.repeat(start, n) + np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)]
-    return pair_point, pair_tri
+class WindingGrid:
+    """A closed, outward-oriented triangle surface (one pose of it) ready for winding
+    numbers: its triangles filed under every ``cell`` (m) of an xy grid that their xy
+    bounding box touches, once, for any number of queries.
+
+    The winding number is counted along a ray going up from each point: +1 for each
+    crossing of an upward-facing triangle (leaving), -1 for a downward-facing one
+    (entering); only the triangles filed under the point's cell are tested.
+    """
+
+    def __init__(self, vertices: np.ndarray, triangles: np.ndarray, cell: float = 0.005):
+        self.corners = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles)]  # (T, 3, 3)
+        self.cell = cell
+        xy = self.corners[..., :2]
+        lo, hi = xy.min(axis=1), xy.max(axis=1)
+        self.origin = lo.min(axis=0)
+        i0 = np.floor((lo - self.origin) / cell).astype(np.int64)
+        i1 = np.floor((hi - self.origin) / cell).astype(np.int64)
+        self.rows = int(i1[:, 1].max()) + 1
+        span = i1 - i0 + 1
+        count = span[:, 0] * span[:, 1]
+        tri = np.repeat(np.arange(len(xy)), count)
+        k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
+        cells = (i0[tri, 0] + k % span[tri, 0]) * self.rows + i0[tri, 1] + k // span[tri, 0]
+        order = np.argsort(cells, kind="stable")
+        self.cells, self.filed = cells[order], tri[order]
+
+    def winding(self, points: np.ndarray) -> np.ndarray:
+        """(N,) int winding numbers at points (N, 3)."""
+        # A fixed irrational nudge keeps rays off the shared edges of axis-aligned data.
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3) + np.array([1.1e-7, 0.7e-7, 0.0])
+        pair_point, pair_tri = self._pairs(p[:, :2])
+        c = self.corners
+        a, b, d = c[pair_tri, 0], c[pair_tri, 1], c[pair_tri, 2]
+        # Barycentrics of the point's xy in the triangle's xy projection.
+        e1, e2, r = b[:, :2] - a[:, :2], d[:, :2] - a[:, :2], p[pair_point, :2] - a[:, :2]
+        det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+        safe = np.where(det != 0, det, 1.0)
+        v = (r[:, 0] * e2[:, 1] - r[:, 1] * e2[:, 0]) / safe
+        w = (e1[:, 0] * r[:, 1] - e1[:, 1] * r[:, 0]) / safe
+        hit = (det != 0) & (v >= 0) & (w >= 0) & (v + w <= 1)
+        z = a[:, 2] + v * (b[:, 2] - a[:, 2]) + w * (d[:, 2] - a[:, 2])
+        hit &= z > p[pair_point, 2]
+        return (
+            np.bincount(pair_point[hit], weights=np.sign(det[hit]), minlength=len(p))
+            .round()
+            .astype(np.int64)
+        )
+
+    def _pairs(self, points_xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(point, triangle) index pairs: each point with the triangles of its cell."""
+        pc = np.floor((points_xy - self.origin) / self.cell).astype(np.int64)
+        valid = (pc[:, 0] >= 0) & (pc[:, 1] >= 0) & (pc[:, 1] < self.rows)
+        key = np.where(valid, pc[:, 0] * self.rows + pc[:, 1], -1)
+        start = np.searchsorted(self.cells, key, "left")
+        stop = np.where(valid, np.searchsorted(self.cells, key, "right"), start)
+        n = stop - start
+        pair_point = np.repeat(np.arange(len(points_xy)), n)
+        offset = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+        return pair_point, self.filed[np.repeat(start, n) + offset]
 
 
 def surface_distance(
@@ -450,6 +461,7 @@ def escape(
     clearance: np.ndarray | float,
     tree: PointTree | None = None,
     normals: np.ndarray | None = None,
+    grid: WindingGrid | None = None,
 ) -> np.ndarray:
     """(N, 3) float32 points with every one inside the body moved out of it.
 
@@ -459,12 +471,14 @@ def escape(
     normal there; one still inside (that skin was itself inside another part) goes to the
     nearest skin vertex whose point ``clearance`` out along its normal is outside (among
     its 16 nearest, else among all).
-    vertices: (V, 3) the body; tree, normals: reuse those built for this pose.
+    vertices: (V, 3) the body; tree, normals, grid: reuse those built for this pose.
     """
     x = np.asarray(vertices, dtype=np.float32)
     out = np.array(points, dtype=np.float32)
     need = np.broadcast_to(np.asarray(clearance, np.float32), (len(out),))
-    inside = np.flatnonzero(winding_number(out, x, surface.triangles) > 0)
+    if grid is None:
+        grid = WindingGrid(x, surface.triangles)
+    inside = np.flatnonzero(grid.winding(out) > 0)
     if len(inside) == 0:
         return out
     if tree is None:
@@ -473,13 +487,13 @@ def escape(
         normals = surface.normals(x)
     q = query(x, surface, out[inside], k=8, tree=tree, normals=normals)
     out[inside] = q.closest + need[inside, None] * q.normal
-    inside = inside[winding_number(out[inside], x, surface.triangles) > 0]
+    inside = inside[grid.winding(out[inside]) > 0]
     # Still inside: the closest skin was itself inside another part (skinning pressed them
     # together). Go to the nearest skin point whose outside really is outside.
     if len(inside):
         _, near = tree.query(out[inside], k=16)
         lifted = x[near] + need[inside, None, None] * normals[near]  # (M, 16, 3)
-        free = winding_number(lifted.reshape(-1, 3), x, surface.triangles).reshape(near.shape)
+        free = grid.winding(lifted.reshape(-1, 3)).reshape(near.shape)
         ok = free <= 0
         first = np.argmax(ok, axis=1)  # nearest first: tree results are sorted
         found = ok[np.arange(len(inside)), first]
@@ -487,7 +501,7 @@ def escape(
         inside = inside[~found]
     if len(inside):  # deep in a part sunk into another (an arm into the chest): all skin
         lifted = x + need[inside].max() * normals
-        free = np.flatnonzero(winding_number(lifted, x, surface.triangles) <= 0)
+        free = np.flatnonzero(grid.winding(lifted) <= 0)
         _, nearest = PointTree(lifted[free]).query(out[inside])
         out[inside] = lifted[free[nearest]]
     return out

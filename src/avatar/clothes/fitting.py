@@ -293,23 +293,33 @@ class Outfit:
             By default each vertex keeps its clearance above the skin it was closest to at
             rest, which moves with it, and is checked against other parts that come near.
         """
-        out = self._frame_anchored(body_posed, matrices)
-        return self._escape(body_posed, out) if exact else out
+        body = self.posed_body(body_posed)
+        out = self._frame_anchored(body, matrices)
+        return self._escape(body, out) if exact else out
 
-    def _escape(self, body: np.ndarray, vertices: list[np.ndarray]) -> list[np.ndarray]:
-        """Each colliding garment's vertices (M_i, 3) with any inside the body (V, 3)
-        moved out of it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
-        skin = collision.PosedBody(self.surface, body[:BODY_VERTEX_COUNT], tree_now=True)
+    def posed_body(self, body_posed: np.ndarray) -> collision.PosedBody:
+        """The skin of a posed body (V, 3) as a collider for this outfit's garments."""
+        return collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT], tree_now=True)
+
+    def _escape(self, skin: collision.PosedBody, vertices: list[np.ndarray]) -> list[np.ndarray]:
+        """Each colliding garment's vertices (M_i, 3) with any inside the skin moved out of
+        it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
         out = list(vertices)
-        for i, (g, anchor) in enumerate(zip(self.garments, self.anchors, strict=True)):
-            if anchor is not None:
-                need = _frame_need(g, anchor, len(out[i]))
-                out[i] = collision.escape(out[i], skin.vertices, self.surface, need, skin.tree,
-                                          skin.normals)  # fmt: skip
+        colliding = [(i, a) for i, a in enumerate(self.anchors) if a is not None]
+        if not colliding:
+            return out
+        index = [i for i, _ in colliding]
+        need = [_frame_need(self.garments[i], a, len(out[i])) for i, a in colliding]
+        # All garments at once: one winding grid and one tree serve every search.
+        points = np.concatenate([out[i] for i in index])
+        moved = collision.escape(points, skin.vertices, self.surface, np.concatenate(need),
+                                 skin.tree, skin.normals)  # fmt: skip
+        sizes = np.cumsum([len(out[i]) for i in index])[:-1]
+        for i, part in zip(index, np.split(moved, sizes), strict=True):
+            out[i] = part
         return out
 
-    def _frame_anchored(self, body_posed: np.ndarray, matrices: np.ndarray) -> list[np.ndarray]:
-        body = collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT], tree_now=True)
+    def _frame_anchored(self, body: collision.PosedBody, matrices: np.ndarray) -> list:
         out, checks = [], []
         for g, rest, w, anchor in zip(
             self.garments, self.rest_surfaces, self.surface_weights, self.anchors, strict=True
@@ -378,8 +388,15 @@ def remote_contacts(body: collision.PosedBody, rest_rows: np.ndarray | None, poi
     if len(far):
         near3[far] = tree.query(points[far], k=1)[1][:, None]
     near = near3[:, 0]
+    remote: np.ndarray | float = REMOTE
+    if rest_rows is not None:
+        # In a pose, a point's own skin can lie as far from its anchor's vertex as the point
+        # is from both (a loose hem's nearest vertex drifts as the body moves): only skin
+        # further than that, at rest, is another part. This halves the exact searches.
+        anchor = np.take(x, rest_near, axis=0)
+        remote = REMOTE + dist[:, 0] + np.sqrt(_dot_rows(points - anchor, points - anchor))
     other = _other_part(body.rows if rest_rows is None else rest_rows, body.rows, near3,
-                        rest_near)  # fmt: skip
+                        rest_near, remote)  # fmt: skip
     normal = np.take(normals, near, axis=0)
     turned = _dot_rows(normal, facing) < FOLD
     # The nearest vertex's tangent plane is a second, independent opinion: where it says
@@ -412,13 +429,14 @@ def remote_contacts(body: collision.PosedBody, rest_rows: np.ndarray | None, poi
     return points
 
 
-def _other_part(rest_rows, rows, near3, rest_near) -> np.ndarray:
-    """(N,) bool: a point's nearest skin vertex lay far, at rest, from its anchor's vertex;
-    or one of its three nearest came closer to that vertex than it was at rest.
+def _other_part(rest_rows, rows, near3, rest_near, remote) -> np.ndarray:
+    """(N,) bool: a point's nearest skin vertex lay further than ``remote`` (m, scalar or
+    (N,)), at rest, from its anchor's vertex; or one of its three nearest came closer to
+    that vertex than it was at rest.
     rest_rows, rows: (3, V) the skin's coordinate rows at rest and now."""
     rest_gap = _distances(rest_rows, near3, rest_near)
     gap = rest_gap if rows is rest_rows else _distances(rows, near3, rest_near)
-    return (rest_gap[:, 0] > REMOTE) | ((rest_gap - gap).max(axis=1) > CLOSING)
+    return (rest_gap[:, 0] > remote) | ((rest_gap - gap).max(axis=1) > CLOSING)
 
 
 def _distances(rows: np.ndarray, near: np.ndarray, anchor: np.ndarray) -> np.ndarray:
@@ -497,7 +515,7 @@ def _escape_rest(outfit: Outfit) -> Outfit:
     """The outfit with every garment vertex inside the rest body moved out of it."""
     assert outfit.rest_body is not None  # _dress sets it
     rest = [g.mesh.vertices for g in outfit.garments]
-    for i, moved in enumerate(outfit._escape(outfit.rest_body, rest)):
+    for i, moved in enumerate(outfit._escape(outfit.posed_body(outfit.rest_body), rest)):
         if moved is rest[i] or np.array_equal(moved, rest[i]):
             continue
         outfit.garments[i] = replace(outfit.garments[i], mesh=outfit[i].mesh.with_vertices(moved))
