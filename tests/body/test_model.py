@@ -164,3 +164,21 @@ def test_memoised_macro_sums_match_full_sums(model):
                 edit = values | {"torso/torso-scale-depth-decr|incr": 0.5}
                 np.testing.assert_array_equal(model.shape(edit), model.shape(edit))
         assert model.macro_sum._contraction.group == group  # the drag used a contraction
+
+
+def test_humans_share_one_model_per_thread():
+    """Making many humans does not load the model each time; another thread gets its own
+    (a model memoises its last shape)."""
+    import threading
+
+    from avatar.body.model import BodyModel
+    from avatar.human import Human
+
+    a, b = Human({"weight": 0.2}), Human({"weight": 0.8})
+    assert a.model is b.model is BodyModel.shared()
+    assert not np.allclose(a.vertices, b.vertices)
+    other = []
+    thread = threading.Thread(target=lambda: other.append(BodyModel.shared()))
+    thread.start()
+    thread.join()
+    assert other[0] is not a.model
