@@ -222,7 +222,13 @@ class AVATAR_OT_apply_motion(bpy.types.Operator):
     def execute(self, context):
         motion = context.scene.avatar.motion()
         obj = context.object
-        return _call(self, lambda: _character().apply_motion(obj, motion))
+
+        def apply():  # the character is rebuilt (garments get per-frame shape keys)
+            built, summary = _character().apply_motion(obj, motion)
+            _select(context, built)
+            return summary
+
+        return _call(self, apply)
 
 
 class AVATAR_OT_bind_garment(bpy.types.Operator):

@@ -59,8 +59,11 @@ def _bvh(human: Human, path: Path, animation: Animation | None, options: dict) -
 def _blender(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
     from avatar.blender import export, scene
 
+    resolve, progress = options.get("resolve_garments", True), options.get("progress", False)
     scene.clear_scene()
-    built = scene.build_character(scene.character_from_human(human, animation=animation))
+    character = scene.character_from_human(human, animation=animation,
+                                           resolve_garments=resolve, progress=progress)  # fmt: skip
+    built = scene.build_character(character)
     export.export(path, [built.root, *built.parts])
 
 
@@ -97,10 +100,11 @@ def save(
         "animation"); players and Blender's importer show it as the clip/action name.
     rest: BVH only: write the skeleton resting in this pose ("t-pose", "a-pose", a pose
         file) with the motion re-expressed on it (``poselib.switch_rest``).
-    resolve_garments: glTF with garments and an animation: bake each frame's penetration
-        resolve (``Outfit.frame(..., exact=True)``) into one morph target per frame,
-        switched on by a weights channel, so viewers show no garment inside the body
-        (``avatar.clothes.bake``; ~0.1-0.3 s a frame). False: plain skinned garments.
+    resolve_garments: glTF/FBX/USD/.blend with garments and an animation: bake each frame's
+        penetration resolve (``Outfit.frame(..., exact=True)``) into one morph target
+        (shape key) per frame, switched on at its frame only by a weights channel (a
+        CONSTANT shape-key action in Blender's formats), so viewers show no garment inside
+        the body (``avatar.clothes.bake``; ~0.1-0.3 s a frame). False: plain skinned garments.
     progress: show a progress bar over long work (the garment bake).
     Formats by suffix: .glb/.gltf (mesh, UVs, skeleton, skin, materials, animation), .obj
     (the skin mesh), .mhm (MakeHuman character file), .bvh (the skeleton and its motion,
@@ -113,7 +117,7 @@ def save(
     path.parent.mkdir(parents=True, exist_ok=True)
     options = {"expressions": expressions, "hide_covered": hide_covered,
                "animation_name": animation_name}  # fmt: skip
-    if path.suffix.lower() in (".glb", ".gltf"):
+    if writer in (_gltf, _blender):
         options |= {"resolve_garments": resolve_garments, "progress": progress}
     if rest:
         options["rest"] = rest

@@ -83,9 +83,12 @@ def test_motion_is_applied_and_survives_update(empty_scene, fake_library, monkey
     monkeypatch.setattr(avatar.motion, "load_bvh", lambda path: (None, path))
     monkeypatch.setattr(avatar.motion, "retarget", retarget)
     built = character.create({"params": {}})
+    built_name = built.root.name
     spec = {"path": "walk.bvh", "frames": [1, 7], "fps": 30, "in_place": False}
-    assert "6 frames" in character.apply_motion(built.parts[0], spec)
-    again = character.update(built.root, {"params": {"height": 0.9}})
+    moved, summary = character.apply_motion(built.parts[0], spec)
+    assert "6 frames" in summary and moved.root.name == built_name
+    assert moved.root.animation_data.action is not None
+    again = character.update(moved.root, {"params": {"height": 0.9}})
     assert again.root.animation_data.action is not None
     assert json.loads(again.root["avatar_motion"]) == spec
     assert calls[-1] == ("walk.bvh", slice(1, 7), 30, False)

@@ -58,45 +58,49 @@ def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.Charact
         from avatar.errors import AvatarError
 
         raise AvatarError(f"{obj.name!r} is not part of an Avatar character")
-    human = realise(recipe)
-    name, location = root.name, tuple(root.location)
-    collection = root.users_collection[0] if root.users_collection else None
     motion = json.loads(root[MOTION_KEY]) if MOTION_KEY in root.keys() else None
-    animation = load_motion(motion, human) if motion else None
-    remove(root, drop_collection=False)
-    character = stage.character_from_human(human, name=name, location=location)
-    if character.recipe is None:
-        from dataclasses import replace
-
-        character = replace(character, recipe=dict(recipe))
-    if animation is not None:
-        from dataclasses import replace
-
-        character = replace(character, animation=animation)
-    built = stage.build_character(character, collection)
-    if motion:
-        built.root[MOTION_KEY] = json.dumps(motion)
-    return built
+    return _rebuild(root, recipe, motion)[0]
 
 
-def apply_motion(obj: bpy.types.Object, motion: Mapping[str, object]) -> str:
-    """Retarget a BVH clip onto the character ``obj`` belongs to and assign it as its action.
+def apply_motion(
+    obj: bpy.types.Object, motion: Mapping[str, object]
+) -> tuple[stage.CharacterObjects, str]:
+    """Retarget a BVH clip onto the character ``obj`` belongs to and rebuild it playing it.
 
     motion: {"path": BVH file, "frames": [start, stop] (see ``load_motion``) or None,
     "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
-    updates re-apply it. Returns a one-line summary.
+    updates re-apply it. The character is rebuilt, not just given an action, because its
+    garments get one corrective shape key per frame (``scene.character_from_human``).
+    Returns the new objects and a one-line summary.
     """
-    from avatar.blender import action as action_bridge
-
     root = root_of(obj)
     if root is None or root.type != "ARMATURE":
         from avatar.errors import AvatarError
 
         raise AvatarError("select a rigged Avatar character first")
-    animation = load_motion(motion, realise(recipe_of(root)))
-    action_bridge.apply_animation(root, animation, f"{root.name} motion")
-    root[MOTION_KEY] = json.dumps(dict(motion))
-    return f"{root.name}: {animation.frames} frames at {animation.fps:g} fps"
+    built, animation = _rebuild(root, recipe_of(root), dict(motion))
+    return built, f"{built.root.name}: {animation.frames} frames at {animation.fps:g} fps"
+
+
+def _rebuild(root: bpy.types.Object, recipe, motion):
+    """(objects, Animation or None): the character ``root`` heads replaced by one realised
+    from ``recipe`` playing ``motion`` (a Motion-panel spec or None). Everything that can
+    fail (realise, retarget, garment bake) runs before the old character is removed."""
+    human = realise(recipe)
+    animation = load_motion(motion, human) if motion else None
+    name, location = root.name, tuple(root.location)
+    collection = root.users_collection[0] if root.users_collection else None
+    character = stage.character_from_human(human, name=name, location=location,
+                                           animation=animation)  # fmt: skip
+    if character.recipe is None:
+        from dataclasses import replace
+
+        character = replace(character, recipe=dict(recipe))
+    remove(root, drop_collection=False)
+    built = stage.build_character(character, collection)
+    if motion:
+        built.root[MOTION_KEY] = json.dumps(dict(motion))
+    return built, animation
 
 
 def load_motion(motion: Mapping[str, object], human) -> object:

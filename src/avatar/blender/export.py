@@ -47,6 +47,9 @@ def _fbx(path: str, selected: bool) -> None:
         use_selection=selected,
         add_leaf_bones=False,  # Avatar's bones have real tails; leaf bones only add clutter
         bake_anim=True,
+        # One animation stack of the scene's timeline: armature action and shape-key
+        # actions together. (The default exports NLA strips only: none, so no animation.)
+        bake_anim_use_nla_strips=False,
         bake_anim_use_all_actions=False,
         path_mode="COPY",
         embed_textures=True,

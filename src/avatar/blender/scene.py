@@ -20,6 +20,7 @@ from avatar.blender import action as action_bridge
 from avatar.blender import armature as armature_bridge
 from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
+from avatar.blender import morph_action
 from avatar.mesh import Mesh
 from avatar.part import MeshPart
 from avatar.rig.skeleton import Animation, Skeleton
@@ -34,6 +35,8 @@ class Character:
     location: (3,) where the armature (or, without one, every part) is placed, metres.
     recipe: JSON-able dict stored on the root object (``avatar_recipe``) so the extension can
     regenerate the character from it.
+    morph_weights: part name -> (T, len(part.morphs)) weights of that part's morphs over the
+    animation's frames (e.g. the baked garment corrections), keyed on its shape keys.
     """
 
     name: str
@@ -42,6 +45,7 @@ class Character:
     animation: Animation | None = None
     location: tuple[float, float, float] = (0.0, 0.0, 0.0)
     recipe: Mapping[str, object] | None = None
+    morph_weights: Mapping[str, np.ndarray] | None = None
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,7 @@ def _build(character: Character, collection: bpy.types.Collection) -> CharacterO
         obj.location = character.location
     if armature is not None and character.animation is not None:
         action_bridge.apply_animation(armature, character.animation, f"{character.name} motion")
+    _key_morphs(character, parts)
     if character.recipe is not None:
         root["avatar_recipe"] = json.dumps(character.recipe)
     return CharacterObjects(root, armature, parts)
@@ -109,12 +114,31 @@ def _build_part(
     return obj
 
 
-def character_from_human(human: object, name: str = "Avatar", **kwargs: object) -> Character:
+def _key_morphs(character: Character, objects: list[bpy.types.Object]) -> None:
+    """Key each part's morph weights on its shape keys, over the animation's frames."""
+    for part, obj in zip(character.parts, objects, strict=True):
+        weights = (character.morph_weights or {}).get(part.name)
+        if weights is not None:
+            morph_action.apply_morph_weights(obj, list(part.morphs), weights,
+                                             f"{character.name} {part.name} morphs")  # fmt: skip
+
+
+def character_from_human(
+    human: object,
+    name: str = "Avatar",
+    resolve_garments: bool = True,
+    progress: bool = False,
+    **kwargs: object,
+) -> Character:
     """Adapt an ``avatar.human.Human``-like object to a Character.
 
     Uses ``human.parts()`` (MeshParts: body, eyes, garments) when it has it, else
     ``human.mesh``, ``human.weights`` and ``human.material`` as one body part; plus
     ``human.skeleton``, ``human.animation`` and ``human.to_recipe()`` when present.
+    resolve_garments: when the human wears garments and an animation is given, bake each
+    frame's penetration resolve into one shape key per frame, keyed 1 at its frame only
+    (``avatar.clothes.bake``, ~0.1-0.3 s a frame), so garments never show inside the body;
+    ``progress`` shows a bar over those frames.
     kwargs override Character fields (e.g. ``location``, ``animation``).
     """
     parts = getattr(human, "parts", None)
@@ -127,7 +151,27 @@ def character_from_human(human: object, name: str = "Avatar", **kwargs: object) 
     fields = dict(name=name, parts=list(parts), skeleton=getattr(human, "skeleton", None),
                   animation=getattr(human, "animation", None), recipe=recipe)  # fmt: skip
     fields.update(kwargs)
-    return Character(**fields)
+    character = Character(**fields)
+    if resolve_garments and character.animation is not None and _wears_garments(human):
+        character = _resolved(human, character, progress)
+    return character
+
+
+def _wears_garments(human: object) -> bool:
+    return bool(getattr(getattr(human, "recipe", None), "clothes", None))
+
+
+def _resolved(human, character: Character, progress: bool) -> Character:
+    """The character with its garments' per-frame corrections as morphs and their weights,
+    baked for Blender's Armature modifier (every vertex group, not glTF's 8)."""
+    from dataclasses import replace
+
+    from avatar.clothes import bake
+
+    parts, weights = bake.bake(human, character.animation, list(character.parts), progress,
+                               skin=bake.vertex_group_skin)  # fmt: skip
+    return replace(character, parts=parts, morph_weights={**(character.morph_weights or {}),
+                                                          **weights})  # fmt: skip
 
 
 def new_collection(name: str, scene: bpy.types.Scene | None = None) -> bpy.types.Collection:

@@ -17,6 +17,7 @@ frame only; frames that need no correction get no target.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -34,8 +35,15 @@ CHUNK = 256  # frames whose bone matrices are computed together
 SINGULAR = 1e-6  # |det A| below which a vertex's blended matrix is inverted by pseudo-inverse
 
 
+SkinOf = Callable[[MeshPart, int], skinning.SkinWeights]  # (part, joint count) -> its skin
+
+
 def bake(
-    human, animation: Animation, parts: list[MeshPart], progress: bool = False
+    human,
+    animation: Animation,
+    parts: list[MeshPart],
+    progress: bool = False,
+    skin: SkinOf | None = None,
 ) -> tuple[list[MeshPart], dict[str, np.ndarray]]:
     """Add one morph target per corrected frame to each garment part of ``parts``.
 
@@ -43,6 +51,8 @@ def bake(
         ``len(human.outfit)`` parts are the garments, as ``library.parts`` makes them).
     animation: (T frames) on ``human.skeleton``.
     progress: show a progress bar (tqdm) over the frames.
+    skin: the weights the player will skin with (default ``file_skin``, a glTF viewer's;
+        ``vertex_group_skin`` for Blender's Armature modifier).
     Returns the parts (garments with extra morphs named ``frame_0007``, after any they
     had; deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32
     morph weights: 1 for frame t's own target at frame t, else 0.
@@ -50,7 +60,7 @@ def bake(
     outfit = human.outfit
     garments = _garment_parts(parts, outfit)
     joints = len(human.skeleton.names)
-    skins = [file_skin(p, joints) for p in garments]
+    skins = [(skin or file_skin)(p, joints) for p in garments]
     corrections: list[dict[int, np.ndarray]] = [{} for _ in garments]
     for t, body, matrices in _frames(human, animation, progress):
         resolved = outfit.frame(body, matrices, exact=True)
@@ -72,6 +82,21 @@ def file_skin(part: MeshPart, joints: int) -> skinning.SkinWeights:
         raise AvatarError(f"garment part {part.name!r} has no skin weights")
     idx, w = pack_weights(part.skin[0], part.skin[1], joints)
     return skinning.SkinWeights(idx.astype(np.int32), w)
+
+
+def vertex_group_skin(part: MeshPart, joints: int) -> skinning.SkinWeights:
+    """The part's skin weights as Blender's Armature modifier blends its vertex groups:
+    every positive influence (no cap at 8), divided by the vertex's sum."""
+    if part.skin is None:
+        raise AvatarError(f"garment part {part.name!r} has no skin weights")
+    idx = np.asarray(part.skin[0], dtype=np.int32)
+    w = np.clip(np.asarray(part.skin[1], dtype=np.float64), 0.0, None)
+    if np.any(idx[w > 0] >= joints) or np.any(idx[w > 0] < 0):
+        raise AvatarError(f"skin of {part.name!r} has a joint index out of range 0..{joints - 1}")
+    total = w.sum(axis=1, keepdims=True)
+    if np.any(total <= 0):  # Blender leaves such a vertex at rest; LBS cannot say that
+        raise AvatarError(f"garment part {part.name!r} has vertices with no skin weight")
+    return skinning.SkinWeights(np.where(w > 0, idx, 0), (w / total).astype(np.float32))
 
 
 def bind_correction(

@@ -1,0 +1,75 @@
+"""Morph weights over time -> an action on a mesh's shape keys (Blender 4.4+ slotted actions).
+
+The baked garment corrections (``avatar.clothes.bake``) are step functions: frame t's
+target is 1 at frame t and 0 elsewhere. Each weight column becomes one F-curve on its
+shape key's ``value`` with CONSTANT interpolation (glTF's STEP), keyed only where the value
+changes (2 or 3 keys a target, not one per frame), written as whole arrays with
+``foreach_set`` like ``avatar.blender.action``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import bpy
+import numpy as np
+from bpy_extras import anim_utils
+
+from avatar.errors import AvatarError
+
+_CONSTANT = 0  # Keyframe.interpolation enum value of 'CONSTANT'
+
+
+def apply_morph_weights(
+    obj: bpy.types.Object,
+    names: Sequence[str],
+    weights: np.ndarray,
+    action_name: str = "Avatar morphs",
+    frame_start: int = 1,
+) -> bpy.types.Action | None:
+    """Key ``obj``'s shape keys ``names`` with ``weights`` (T, len(names)) at frames
+    frame_start .. frame_start + T - 1; columns that stay 0 get no F-curve.
+
+    Returns the action assigned to the mesh's Key datablock, or None when nothing moves.
+    Raises AvatarError when a name is not a shape key of ``obj``.
+    """
+    weights = np.asarray(weights, dtype=np.float32)
+    if weights.ndim != 2 or weights.shape[1] != len(names):
+        raise AvatarError(f"morph weights of {obj.name!r} must be (T, {len(names)}), "
+                          f"got {weights.shape}")  # fmt: skip
+    keys = obj.data.shape_keys
+    missing = [n for n in names if keys is None or n not in keys.key_blocks]
+    if missing:
+        raise AvatarError(f"{obj.name!r} has no shape key {missing[0]!r}")
+    moving = np.flatnonzero(np.any(weights != 0, axis=0))
+    if not len(moving):
+        return None
+    channelbag, action = _channelbag(keys, action_name)
+    for k in moving:
+        _write_steps(channelbag, names[k], weights[:, k], frame_start)
+    return action
+
+
+def _channelbag(keys: bpy.types.Key, name: str):
+    """A new action with one KEY slot, assigned to ``keys``, and its channelbag."""
+    action = bpy.data.actions.new(name)
+    slot = action.slots.new(id_type="KEY", name=keys.name)
+    keys.animation_data_create()
+    keys.animation_data.action = action
+    keys.animation_data.action_slot = slot
+    return anim_utils.action_ensure_channelbag_for_slot(action, slot), action
+
+
+def _write_steps(channelbag, name: str, values: np.ndarray, frame_start: int) -> None:
+    """One CONSTANT F-curve ``key_blocks[name].value`` keyed at the first frame and wherever
+    ``values`` (T,) changes; constant extrapolation holds the ends."""
+    changes = np.flatnonzero(np.diff(values) != 0) + 1
+    at = np.concatenate([[0], changes])
+    co = np.empty((len(at), 2), dtype=np.float32)
+    co[:, 0], co[:, 1] = frame_start + at, values[at]
+    curve = channelbag.fcurves.new(f'key_blocks["{bpy.utils.escape_identifier(name)}"].value')
+    points = curve.keyframe_points
+    points.add(len(at))
+    points.foreach_set("co", co.ravel())
+    points.foreach_set("interpolation", np.full(len(at), _CONSTANT, dtype=np.int32))
+    curve.update()
