@@ -177,6 +177,11 @@ def test_humans_share_one_model_per_thread():
     a, b = Human({"weight": 0.2}), Human({"weight": 0.8})
     assert a.model is b.model is BodyModel.shared()
     assert not np.allclose(a.vertices, b.vertices)
+    # Bit for bit what a fresh model gives, whatever came before (a slider "dragged").
+    for weight in (0.3, 0.31, 0.32, 0.2):
+        again = Human({"weight": weight, "gender": 0.4}).vertices
+        fresh = Human({"weight": weight, "gender": 0.4}, model=BodyModel.load()).vertices
+        assert np.array_equal(again, fresh)
     other = []
     thread = threading.Thread(target=lambda: other.append(BodyModel.shared()))
     thread.start()

@@ -84,8 +84,11 @@ class MacroSum:
 
     Memos are replaced whole, never mutated, and every result is a fresh array: ``shape``
     stays a pure function of its parameters. Results agree with a plain float32 sum within
-    float32 rounding (~1e-7 m).
+    float32 rounding (~1e-7 m); with ``contract`` off (``BodyModel.shared``) they are that
+    sum exactly, whatever bodies came before (reproducible datasets).
     """
+
+    contract = True  # build the drag contraction (faster edits, history-dependent rounding)
 
     def __init__(self, table: macros.MacroTable, dense: np.ndarray, spans: list[tuple[int, int]]):
         self.table = table
@@ -105,7 +108,7 @@ class MacroSum:
         if last is not None and last[0] == key and last[1] is not None:
             return last[1].copy()
         edited = _changed_group(last[0], key) if last is not None else None
-        if edited is not None and last is not None and edited == last[2]:  # dragged twice
+        if self.contract and edited is not None and last is not None and edited == last[2]:
             con = self._contraction = self._contract(edited, values, key)
             self._last = (key, None, edited)
             return con.evaluate(values)
@@ -213,11 +216,14 @@ class BodyModel:
         """This thread's model over the default assets, loaded once (a load takes ~50 ms,
         a body ~1 ms): what ``Human`` uses when given no model. Per thread because a model
         memoises its last shape; a change of ``AVATAR_ASSETS`` or ``AVATAR_CACHE`` loads
-        anew."""
+        anew. Its shapes are exact sums (no drag contraction), so a body is bit for bit the
+        same whichever bodies were made before it."""
         key = (os.environ.get("AVATAR_ASSETS"), os.environ.get("AVATAR_CACHE"))
         cached = getattr(_SHARED, "model", None)
         if cached is None or cached[0] != key:
-            _SHARED.model = cached = (key, cls.load())
+            model = cls.load()
+            model.macro_sum.contract = False
+            _SHARED.model = cached = (key, model)
         return cached[1]
 
     def skin_weights(self, rig: str, bone_names: tuple[str, ...]) -> SkinWeights:

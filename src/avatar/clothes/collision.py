@@ -374,38 +374,50 @@ class WindingGrid:
     """
 
     def __init__(self, vertices: np.ndarray, triangles: np.ndarray, cell: float = 0.005):
-        self.corners = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles)]  # (T, 3, 3)
+        x = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64).T)  # (3, V)
+        t = np.ascontiguousarray(np.asarray(triangles).T, dtype=np.intp)  # (3, T)
+        # Per triangle, as coordinate rows: corner a, the xy edges to b and c, their
+        # determinant (orientation) and the z rises along them.
+        a = [np.take(row, t[0]) for row in x]
+        b = [np.take(row, t[1]) for row in x]
+        c = [np.take(row, t[2]) for row in x]
+        self.a = a
+        self.e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+        self.e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]]
+        self.det = self.e1[0] * self.e2[1] - self.e1[1] * self.e2[0]
         self.cell = cell
-        xy = self.corners[..., :2]
-        lo, hi = xy.min(axis=1), xy.max(axis=1)
-        self.origin = lo.min(axis=0)
-        i0 = np.floor((lo - self.origin) / cell).astype(np.int64)
-        i1 = np.floor((hi - self.origin) / cell).astype(np.int64)
-        self.rows = int(i1[:, 1].max()) + 1
-        span = i1 - i0 + 1
-        count = span[:, 0] * span[:, 1]
-        tri = np.repeat(np.arange(len(xy)), count)
+        lo = [np.minimum(np.minimum(a[d], b[d]), c[d]) for d in range(2)]
+        hi = [np.maximum(np.maximum(a[d], b[d]), c[d]) for d in range(2)]
+        self.origin = np.array([lo[0].min(), lo[1].min()])
+        i0 = [np.floor((lo[d] - self.origin[d]) / cell).astype(np.int64) for d in range(2)]
+        i1 = [np.floor((hi[d] - self.origin[d]) / cell).astype(np.int64) for d in range(2)]
+        self.rows = int(i1[1].max()) + 1
+        span = [i1[d] - i0[d] + 1 for d in range(2)]
+        count = span[0] * span[1]
+        tri = np.repeat(np.arange(len(count)), count)
         k = np.arange(len(tri)) - np.repeat(np.cumsum(count) - count, count)
-        cells = (i0[tri, 0] + k % span[tri, 0]) * self.rows + i0[tri, 1] + k // span[tri, 0]
-        order = np.argsort(cells, kind="stable")
-        self.cells, self.filed = cells[order], tri[order]
+        width = np.take(span[0], tri)
+        cells = (np.take(i0[0], tri) + k % width) * self.rows + np.take(i0[1], tri) + k // width
+        # Small keys sort by radix: a body's few thousand cells fit in 16 bits.
+        key = cells.astype(np.uint16) if cells.max() < 2**16 else cells
+        order = np.argsort(key, kind="stable")
+        self.cells, self.filed = np.take(cells, order), np.take(tri, order)
 
     def winding(self, points: np.ndarray) -> np.ndarray:
         """(N,) int winding numbers at points (N, 3)."""
         # A fixed irrational nudge keeps rays off the shared edges of axis-aligned data.
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3) + np.array([1.1e-7, 0.7e-7, 0.0])
         pair_point, pair_tri = self._pairs(p[:, :2])
-        c = self.corners
-        a, b, d = c[pair_tri, 0], c[pair_tri, 1], c[pair_tri, 2]
+        q = [np.take(p[:, d], pair_point) - np.take(self.a[d], pair_tri) for d in range(3)]
+        e1 = [np.take(e, pair_tri) for e in self.e1]
+        e2 = [np.take(e, pair_tri) for e in self.e2]
+        det = np.take(self.det, pair_tri)
         # Barycentrics of the point's xy in the triangle's xy projection.
-        e1, e2, r = b[:, :2] - a[:, :2], d[:, :2] - a[:, :2], p[pair_point, :2] - a[:, :2]
-        det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
         safe = np.where(det != 0, det, 1.0)
-        v = (r[:, 0] * e2[:, 1] - r[:, 1] * e2[:, 0]) / safe
-        w = (e1[:, 0] * r[:, 1] - e1[:, 1] * r[:, 0]) / safe
+        v = (q[0] * e2[1] - q[1] * e2[0]) / safe
+        w = (e1[0] * q[1] - e1[1] * q[0]) / safe
         hit = (det != 0) & (v >= 0) & (w >= 0) & (v + w <= 1)
-        z = a[:, 2] + v * (b[:, 2] - a[:, 2]) + w * (d[:, 2] - a[:, 2])
-        hit &= z > p[pair_point, 2]
+        hit &= v * e1[2] + w * e2[2] > q[2]  # the triangle is above the point
         return (
             np.bincount(pair_point[hit], weights=np.sign(det[hit]), minlength=len(p))
             .round()
