@@ -320,43 +320,124 @@ class Outfit:
         return out
 
     def _frame_anchored(self, body: collision.PosedBody, matrices: np.ndarray) -> list:
-        out, checks = [], []
-        for g, rest, w, anchor in zip(
-            self.garments, self.rest_surfaces, self.surface_weights, self.anchors, strict=True
-        ):
-            points = linear_blend(rest, w, matrices)
-            if anchor is None:
-                out.append(points)
-                continue
-            q = body.anchored(points, anchor[0], anchor[1])
-            points = _shell_frame(g, collision.push_out(points, q, anchor[2]), q)
-            facing = q.normal
-            if len(anchor) > 4:  # the outer layer keeps clear of the skin it is closest to
-                n = len(anchor[2])
-                qo = body.anchored(points[n:], anchor[4], anchor[5])
-                points[n:] = collision.push_out(points[n:], qo, anchor[6])
-                facing = np.concatenate([q.normal, qo.normal])
-            # Both shell layers: where the body folds, the outer one can reach the next part.
-            need, near = anchor[2], anchor[3]
-            if len(anchor) > 4:
-                need, near = np.concatenate([need, need]), np.concatenate([near, anchor[7]])
-            out.append(points)
-            checks.append((len(out) - 1, need, near, facing))
-        if checks:  # one search for all garments (each point is checked on its own)
-            index, need, near, facing = zip(*checks, strict=True)
-            sizes = [len(out[i]) for i in index]
-            joined = remote_contacts(
-                body,
-                self.rest_rows,
-                np.concatenate([out[i] for i in index]),
-                np.concatenate(need),
-                np.concatenate(near),
-                np.concatenate(facing),
-                iterations=4,
-            )
-            for i, part in zip(index, np.split(joined, np.cumsum(sizes)[:-1]), strict=True):
-                out[i] = part
+        """Each garment skinned, kept clear of the skin it is anchored to (a shell's outer
+        layer too), then all colliding points checked together against other body parts."""
+        lay = self._layout
+        skinned = linear_blend(lay.rest, lay.weights, matrices)
+        if not lay.colliding_garments:
+            return np.split(skinned, lay.splits)
+        points = skinned[lay.colliding]
+        q = body.anchored(points, lay.triangle, lay.bary)
+        inner = collision.push_out(points, q, lay.need)
+        # Shells: the outer layer grown along the skin normal, then kept clear of the skin
+        # it is closest to.
+        outer = inner[lay.shell] + lay.thickness[:, None] * q.normal[lay.shell]
+        qo = body.anchored(outer, lay.outer_triangle, lay.outer_bary)
+        outer = collision.push_out(outer, qo, lay.outer_need)
+        # One search for all garments, both shell layers (where the body folds, the outer
+        # one can reach the next part); each point is checked on its own.
+        order = lay.remote_order
+        joined = remote_contacts(
+            body,
+            self.rest_rows,
+            np.concatenate([inner, outer])[order],
+            lay.remote_need,
+            lay.remote_near,
+            np.concatenate([q.normal, qo.normal])[order],
+            iterations=4,
+        )
+        out = np.split(skinned, lay.splits)
+        for i, part in zip(lay.colliding_garments, np.split(joined, lay.remote_splits),
+                           strict=True):  # fmt: skip
+            out[i] = part
         return out
+
+    @cached_property
+    def _layout(self) -> _FrameLayout:
+        return _FrameLayout.of(self)
+
+
+@dataclass(frozen=True, eq=False)
+class _FrameLayout:
+    """An outfit's garments laid end to end, so that a posed frame skins and anchors them
+    all in a few whole-array steps (``Outfit._frame_anchored``)."""
+
+    rest: np.ndarray  # (N, 3) every garment's bound surface at rest, garment after garment
+    weights: SkinWeights  # (N, K) their frame weights
+    splits: np.ndarray  # where each garment's rows start (np.split)
+    colliding: np.ndarray  # (C,) rows of colliding garments
+    triangle: np.ndarray  # (C,) their rest anchors, barycentrics (C, 3), clearances (C,)
+    bary: np.ndarray
+    need: np.ndarray
+    shell: np.ndarray  # (S,) which of the C rows carry a shell's outer layer
+    thickness: np.ndarray  # (S,) float32 that shell's thickness
+    outer_triangle: np.ndarray  # (S,) the outer layer's anchors and clearances
+    outer_bary: np.ndarray
+    outer_need: np.ndarray
+    remote_order: np.ndarray  # rows of [inner; outer] in output order (inner, outer per garment)
+    remote_need: np.ndarray  # their clearances and rest nearest skin vertices, in that order
+    remote_near: np.ndarray
+    remote_splits: np.ndarray
+    colliding_garments: list[int]
+
+    @classmethod
+    def of(cls, outfit: Outfit) -> _FrameLayout:
+        rests, ws = outfit.rest_surfaces, outfit.surface_weights
+        width = max(w.indices.shape[1] for w in ws)
+        weights = SkinWeights(_cat([_pad(w.indices, width) for w in ws], np.int32),
+                              _cat([_pad(w.weights, width) for w in ws], np.float32))  # fmt: skip
+        starts = np.cumsum([0] + [len(r) for r in rests])
+        pairs = enumerate(zip(outfit.garments, outfit.anchors, strict=True))
+        hits = [(i, g, a) for i, (g, a) in pairs if a is not None]
+        shells = [(g, a) for _, g, a in hits if len(a) > 4]
+        # Rows of [inner; outer] as the garments' outputs take them: each garment's inner
+        # layer, then its outer layer if it is a shell.
+        inner_at = np.cumsum([0] + [len(a[2]) for _, _, a in hits])
+        outer_at = inner_at[-1] + np.cumsum([0] + [len(a[2]) for _, a in shells])
+        order, need, near, sizes, s = [], [], [], [], 0
+        for k, (_, _, a) in enumerate(hits):
+            order.append(np.arange(inner_at[k], inner_at[k + 1]))
+            need.append(a[2])
+            near.append(a[3])
+            if len(a) > 4:
+                order.append(np.arange(outer_at[s], outer_at[s + 1]))
+                need.append(a[2])
+                near.append(a[7])
+                s += 1
+            sizes.append(len(a[2]) * (2 if len(a) > 4 else 1))
+        return cls(
+            rest=_cat(rests, np.float32),
+            weights=weights,
+            splits=starts[1:-1],
+            colliding=_cat([np.arange(starts[i], starts[i + 1]) for i, _, _ in hits], np.intp),
+            triangle=_cat([a[0] for _, _, a in hits], np.int32),
+            bary=_cat([a[1] for _, _, a in hits], np.float32, 3),
+            need=_cat([a[2] for _, _, a in hits], np.float32),
+            shell=_cat([np.arange(inner_at[k], inner_at[k + 1])
+                        for k, (_, _, a) in enumerate(hits) if len(a) > 4], np.intp),  # fmt: skip
+            thickness=_cat([np.full(len(a[2]), g.garment.thickness) for g, a in shells],
+                           np.float32),  # fmt: skip
+            outer_triangle=_cat([a[4] for _, a in shells], np.int32),
+            outer_bary=_cat([a[5] for _, a in shells], np.float32, 3),
+            outer_need=_cat([a[6] for _, a in shells], np.float32),
+            remote_order=_cat(order, np.intp),
+            remote_need=_cat(need, np.float32),
+            remote_near=_cat(near, np.intp),
+            remote_splits=np.cumsum(sizes)[:-1],
+            colliding_garments=[i for i, _, _ in hits],
+        )
+
+
+def _cat(arrays: list, dtype, width: int | None = None) -> np.ndarray:
+    """The arrays end to end as ``dtype`` (an empty (0,) or (0, width) array for none)."""
+    if not arrays:
+        return np.zeros((0,) if width is None else (0, width), dtype)
+    return np.concatenate(arrays).astype(dtype)
+
+
+def _pad(a: np.ndarray, width: int) -> np.ndarray:
+    """(N, width) a padded on the right with zeros (index 0, weight 0: no influence)."""
+    return np.pad(a, ((0, 0), (0, width - a.shape[1])))
 
 
 def _frame_need(g: FittedGarment, anchor: tuple, count: int) -> np.ndarray:
@@ -451,12 +532,6 @@ def _distances(rows: np.ndarray, near: np.ndarray, anchor: np.ndarray) -> np.nda
 
 def _dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("nd,nd->n", a, b)
-
-
-def _shell_frame(g: FittedGarment, points: np.ndarray, q) -> np.ndarray:
-    if g.garment.shell is None or q is None:
-        return points
-    return extrude(points, q.normal, g.garment.thickness)
 
 
 def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple:
