@@ -113,8 +113,9 @@ def _add_create(sub: argparse._SubParsersAction) -> None:
         "--no-resolve-garments",
         dest="resolve_garments",
         action="store_false",
-        help="glTF: skin garments plainly instead of baking each frame's penetration "
-        "resolve into morph targets (faster, smaller; garments may clip into the body)",
+        help="glTF/FBX/USD/.blend: skin garments plainly instead of baking each frame's "
+        "penetration resolve into morph targets / shape keys (faster, smaller; garments may "
+        "clip into the body)",
     )
     p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
     p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")

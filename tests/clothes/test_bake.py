@@ -125,3 +125,20 @@ def test_bind_correction_lands_skinning_on_the_wanted_points():
     got = skinning.linear_blend(rest + delta, skin, matrices)
     np.testing.assert_allclose(got[50:], wanted[50:], atol=2e-5)
     assert bake.bind_correction(rest, skin, matrices, posed) is None
+
+
+def test_vertex_group_skin_keeps_every_influence_renormalised():
+    """Blender's Armature modifier blends all vertex groups (no cap at 8), over their sum."""
+    from avatar.mesh import Mesh
+    from avatar.part import MeshPart
+
+    rng = np.random.default_rng(5)
+    idx = np.tile(np.arange(10, dtype=np.int32), (4, 1))
+    w = rng.random((4, 10))
+    w[1, 3], w[2] = -0.2, 0.0  # a negative weight is dropped; vertex 2 has none at all
+    mesh = Mesh(rng.normal(size=(4, 3)).astype(np.float32), np.array([[0, 1, 2]]))
+    skin = bake.vertex_group_skin(MeshPart("cape", mesh, skin=(idx, w)), 12)
+    np.testing.assert_allclose(skin.weights.sum(axis=1), 1.0, atol=1e-6)
+    assert np.count_nonzero(skin.weights[0]) == 10 and skin.weights[1, 3] == 0
+    assert skin.indices[2, 0] == 0 and skin.weights[2, 0] == 1.0  # follows the root
+    np.testing.assert_allclose(skin.weights[0], w[0] / w[0].sum(), rtol=1e-6)

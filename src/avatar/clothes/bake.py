@@ -89,14 +89,16 @@ def vertex_group_skin(part: MeshPart, joints: int) -> skinning.SkinWeights:
     every positive influence (no cap at 8), divided by the vertex's sum."""
     if part.skin is None:
         raise AvatarError(f"garment part {part.name!r} has no skin weights")
-    idx = np.asarray(part.skin[0], dtype=np.int32)
+    idx = np.array(part.skin[0], dtype=np.int32)
     w = np.clip(np.asarray(part.skin[1], dtype=np.float64), 0.0, None)
     if np.any(idx[w > 0] >= joints) or np.any(idx[w > 0] < 0):
         raise AvatarError(f"skin of {part.name!r} has a joint index out of range 0..{joints - 1}")
-    total = w.sum(axis=1, keepdims=True)
-    if np.any(total <= 0):  # Blender leaves such a vertex at rest; LBS cannot say that
-        raise AvatarError(f"garment part {part.name!r} has vertices with no skin weight")
-    return skinning.SkinWeights(np.where(w > 0, idx, 0), (w / total).astype(np.float32))
+    empty = w.sum(axis=1) <= 0
+    if empty.any():  # Blender leaves these at rest, which LBS cannot say: the root's, as glTF
+        log.warning("%s: %d vertices without skin weight follow the root", part.name, empty.sum())
+        w[empty, 0], idx[empty, 0] = 1.0, 0
+    w /= w.sum(axis=1, keepdims=True)
+    return skinning.SkinWeights(np.where(w > 0, idx, 0), w.astype(np.float32))
 
 
 def bind_correction(
