@@ -133,6 +133,22 @@ class SurfaceQuery:
     triangle: np.ndarray | None = None
     bary: np.ndarray | None = None
 
+    def take(self, index: np.ndarray) -> SurfaceQuery:
+        """The rows ``index`` of this query."""
+        return SurfaceQuery(*(getattr(self, f)[index] for f in _QUERY_FIELDS))
+
+    def put(self, index: np.ndarray, part: SurfaceQuery) -> SurfaceQuery:
+        """This query with rows ``index`` replaced by ``part``'s."""
+        fields = []
+        for f in _QUERY_FIELDS:
+            whole = getattr(self, f).copy()
+            whole[index] = getattr(part, f)
+            fields.append(whole)
+        return SurfaceQuery(*fields)
+
+
+_QUERY_FIELDS = ("distance", "closest", "normal", "vertex", "triangle", "bary")
+
 
 def closest_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """(..., 3) barycentric weights of the closest point to p on triangles abc (all (..., 3))."""

@@ -1,0 +1,223 @@
+"""An outfit: garments fitted on one body, and their posed frames.
+
+``Outfit.frame(body, matrices)`` skins every garment, keeps each point clear of the skin it
+was anchored to at rest, and checks the points near other body parts
+(``contacts.remote_contacts``); ``exact=True`` then tests every vertex by winding number.
+A frame is a pure function of the pose: frames can be made in any order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from avatar.body.model import BODY_VERTICES
+from avatar.clothes import collision
+from avatar.clothes.contacts import remote_contacts
+from avatar.rig.skinning import SkinWeights, linear_blend
+
+if TYPE_CHECKING:
+    from avatar.clothes.fitting import FittedGarment
+
+BODY_VERTEX_COUNT = BODY_VERTICES
+
+
+@dataclass(eq=False)
+class Outfit:
+    """Garments fitted on one body, able to follow it through posed frames."""
+
+    garments: list[FittedGarment]
+    surface: collision.BodySurface
+    rest_surfaces: list[np.ndarray]  # (N, 3) resolved bound surface per garment
+    surface_weights: list[SkinWeights]
+    # Per colliding garment: the rest-pose closest triangle, its barycentrics, the clearance
+    # each vertex must keep (skin clearance or the layer below plus a gap), and the nearest
+    # skin vertex at rest.
+    anchors: list[tuple[np.ndarray, ...] | None] = field(default_factory=list)
+    rest_body: np.ndarray | None = None  # (13380, 3) skin at rest, to tell remote contacts
+
+    # An Outfit reads as the list of its FittedGarments.
+    def __iter__(self):
+        return iter(self.garments)
+
+    def __len__(self) -> int:
+        return len(self.garments)
+
+    def __getitem__(self, i: int) -> FittedGarment:
+        return self.garments[i]
+
+    @cached_property
+    def rest_rows(self) -> np.ndarray:
+        """(3, 13380) float32 the rest skin's coordinate rows (``remote_contacts``)."""
+        return np.ascontiguousarray(np.asarray(self.rest_body, dtype=np.float32).T)
+
+    def frame(
+        self, body_posed: np.ndarray, matrices: np.ndarray, exact: bool = False
+    ) -> list[np.ndarray]:
+        """Garment vertices (M_i, 3) for one posed frame.
+
+        body_posed: (V, 3) the body skinned with ``matrices`` (J, 4, 4) skinning matrices.
+        exact: guarantee that no garment vertex is inside the body (for datasets and
+            exports; several times slower): after the real-time resolve, every garment
+            vertex is tested by winding number, which stays right where skinning drove one
+            body part into another, and any inside is moved out (``collision.escape``).
+            By default each vertex keeps its clearance above the skin it was closest to at
+            rest, which moves with it, and is checked against other parts that come near.
+        """
+        body = self.posed_body(body_posed)
+        out = self._frame_anchored(body, matrices)
+        return self._escape(body, out) if exact else out
+
+    def posed_body(self, body_posed: np.ndarray) -> collision.PosedBody:
+        """The skin of a posed body (V, 3) as a collider for this outfit's garments."""
+        return collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT], tree_now=True)
+
+    def _escape(self, skin: collision.PosedBody, vertices: list[np.ndarray]) -> list[np.ndarray]:
+        """Each colliding garment's vertices (M_i, 3) with any inside the skin moved out of
+        it by ``collision.escape``, keeping its clearance (``_frame_need``)."""
+        out = list(vertices)
+        colliding = [(i, a) for i, a in enumerate(self.anchors) if a is not None]
+        if not colliding:
+            return out
+        index = [i for i, _ in colliding]
+        need = [_frame_need(self.garments[i], a, len(out[i])) for i, a in colliding]
+        # All garments at once: one winding grid and one tree serve every search.
+        points = np.concatenate([out[i] for i in index])
+        moved = collision.escape(points, skin.vertices, self.surface, np.concatenate(need),
+                                 skin.tree, skin.normals)  # fmt: skip
+        sizes = np.cumsum([len(out[i]) for i in index])[:-1]
+        for i, part in zip(index, np.split(moved, sizes), strict=True):
+            out[i] = part
+        return out
+
+    def _frame_anchored(self, body: collision.PosedBody, matrices: np.ndarray) -> list:
+        """Each garment skinned, kept clear of the skin it is anchored to (a shell's outer
+        layer too), then all colliding points checked together against other body parts."""
+        lay = self._layout
+        skinned = linear_blend(lay.rest, lay.weights, matrices)
+        if not lay.colliding_garments:
+            return np.split(skinned, lay.splits)
+        points = skinned[lay.colliding]
+        q = body.anchored(points, lay.triangle, lay.bary)
+        inner = collision.push_out(points, q, lay.need)
+        # Shells: the outer layer grown along the skin normal, then kept clear of the skin
+        # it is closest to.
+        outer = inner[lay.shell] + lay.thickness[:, None] * q.normal[lay.shell]
+        qo = body.anchored(outer, lay.outer_triangle, lay.outer_bary)
+        outer = collision.push_out(outer, qo, lay.outer_need)
+        # One search for all garments, both shell layers (where the body folds, the outer
+        # one can reach the next part); each point is checked on its own.
+        order = lay.remote_order
+        joined = remote_contacts(
+            body,
+            self.rest_rows,
+            np.concatenate([inner, outer])[order],
+            lay.remote_need,
+            lay.remote_near,
+            np.concatenate([q.normal, qo.normal])[order],
+            iterations=4,
+        )
+        out = np.split(skinned, lay.splits)
+        for i, part in zip(lay.colliding_garments, np.split(joined, lay.remote_splits),
+                           strict=True):  # fmt: skip
+            out[i] = part
+        return out
+
+    @cached_property
+    def _layout(self) -> _FrameLayout:
+        return _FrameLayout.of(self)
+
+
+@dataclass(frozen=True, eq=False)
+class _FrameLayout:
+    """An outfit's garments laid end to end, so that a posed frame skins and anchors them
+    all in a few whole-array steps (``Outfit._frame_anchored``)."""
+
+    rest: np.ndarray  # (N, 3) every garment's bound surface at rest, garment after garment
+    weights: SkinWeights  # (N, K) their frame weights
+    splits: np.ndarray  # where each garment's rows start (np.split)
+    colliding: np.ndarray  # (C,) rows of colliding garments
+    triangle: np.ndarray  # (C,) their rest anchors, barycentrics (C, 3), clearances (C,)
+    bary: np.ndarray
+    need: np.ndarray
+    shell: np.ndarray  # (S,) which of the C rows carry a shell's outer layer
+    thickness: np.ndarray  # (S,) float32 that shell's thickness
+    outer_triangle: np.ndarray  # (S,) the outer layer's anchors and clearances
+    outer_bary: np.ndarray
+    outer_need: np.ndarray
+    remote_order: np.ndarray  # rows of [inner; outer] in output order (inner, outer per garment)
+    remote_need: np.ndarray  # their clearances and rest nearest skin vertices, in that order
+    remote_near: np.ndarray
+    remote_splits: np.ndarray
+    colliding_garments: list[int]
+
+    @classmethod
+    def of(cls, outfit: Outfit) -> _FrameLayout:
+        rests, ws = outfit.rest_surfaces, outfit.surface_weights
+        width = max(w.indices.shape[1] for w in ws)
+        weights = SkinWeights(_cat([_pad(w.indices, width) for w in ws], np.int32),
+                              _cat([_pad(w.weights, width) for w in ws], np.float32))  # fmt: skip
+        starts = np.cumsum([0] + [len(r) for r in rests])
+        pairs = enumerate(zip(outfit.garments, outfit.anchors, strict=True))
+        hits = [(i, g, a) for i, (g, a) in pairs if a is not None]
+        shells = [(g, a) for _, g, a in hits if len(a) > 4]
+        # Rows of [inner; outer] as the garments' outputs take them: each garment's inner
+        # layer, then its outer layer if it is a shell.
+        inner_at = np.cumsum([0] + [len(a[2]) for _, _, a in hits])
+        outer_at = inner_at[-1] + np.cumsum([0] + [len(a[2]) for _, a in shells])
+        order, need, near, sizes, s = [], [], [], [], 0
+        for k, (_, _, a) in enumerate(hits):
+            order.append(np.arange(inner_at[k], inner_at[k + 1]))
+            need.append(a[2])
+            near.append(a[3])
+            if len(a) > 4:
+                order.append(np.arange(outer_at[s], outer_at[s + 1]))
+                need.append(a[2])
+                near.append(a[7])
+                s += 1
+            sizes.append(len(a[2]) * (2 if len(a) > 4 else 1))
+        return cls(
+            rest=_cat(rests, np.float32),
+            weights=weights,
+            splits=starts[1:-1],
+            colliding=_cat([np.arange(starts[i], starts[i + 1]) for i, _, _ in hits], np.intp),
+            triangle=_cat([a[0] for _, _, a in hits], np.int32),
+            bary=_cat([a[1] for _, _, a in hits], np.float32, 3),
+            need=_cat([a[2] for _, _, a in hits], np.float32),
+            shell=_cat([np.arange(inner_at[k], inner_at[k + 1])
+                        for k, (_, _, a) in enumerate(hits) if len(a) > 4], np.intp),  # fmt: skip
+            thickness=_cat([np.full(len(a[2]), g.garment.thickness) for g, a in shells],
+                           np.float32),  # fmt: skip
+            outer_triangle=_cat([a[4] for _, a in shells], np.int32),
+            outer_bary=_cat([a[5] for _, a in shells], np.float32, 3),
+            outer_need=_cat([a[6] for _, a in shells], np.float32),
+            remote_order=_cat(order, np.intp),
+            remote_need=_cat(need, np.float32),
+            remote_near=_cat(near, np.intp),
+            remote_splits=np.cumsum(sizes)[:-1],
+            colliding_garments=[i for i, _, _ in hits],
+        )
+
+
+def _cat(arrays: list, dtype, width: int | None = None) -> np.ndarray:
+    """The arrays end to end as ``dtype`` (an empty (0,) or (0, width) array for none)."""
+    if not arrays:
+        return np.zeros((0,) if width is None else (0, width), dtype)
+    return np.concatenate(arrays).astype(dtype)
+
+
+def _pad(a: np.ndarray, width: int) -> np.ndarray:
+    """(N, width) a padded on the right with zeros (index 0, weight 0: no influence)."""
+    return np.pad(a, ((0, 0), (0, width - a.shape[1])))
+
+
+def _frame_need(g: FittedGarment, anchor: tuple, count: int) -> np.ndarray:
+    """(M,) m each posed garment vertex keeps from the skin: its rest clearance (the
+    layer below plus a gap), and for a shell's outer layer that plus the thickness."""
+    need = anchor[2]
+    if count > len(need):
+        need = np.concatenate([need, need + np.float32(g.garment.thickness)])
+    return need
