@@ -4,9 +4,9 @@
 
 Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
 from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``,
-download the binary wheels of the dependencies Blender lacks (SciPy, and Pillow for garment
-textures; Blender ships numpy, and pygltflib/tqdm are imported only by glTF export and the
-CLI) for the target platform and
+download the binary wheels of the dependencies Blender lacks (SciPy, pykdtree for the
+clothes' searches, and Pillow for garment textures; Blender ships numpy, and pygltflib/tqdm
+are imported only by glTF export and the CLI) for the target platform and
 Blender's Python, list them in the manifest, then run Blender's own ``blender_ext.py build``
 and ``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
 (``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
@@ -98,15 +98,22 @@ def build_wheel(folder: Path) -> Path:
 
 
 def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Path]:
-    """SciPy's and Pillow's binary wheels for ``platform`` and ``python``, the versions
-    installed here (Blender ships numpy but neither of these)."""
+    """SciPy's, Pillow's and pykdtree's binary wheels for ``platform`` and ``python``, the
+    versions installed here (Blender ships numpy but none of these). pykdtree has no wheel
+    for some platforms (older macOS tags); there the clothes code uses SciPy's k-d tree."""
     from importlib.metadata import version
 
     before = set(folder.glob("*.whl"))
-    _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
-         "--only-binary=:all:", "--python-version", python, "--platform",
-         PIP_PLATFORMS[platform], "-d", folder, f"scipy=={version('scipy')}",
-         f"pillow=={version('pillow')}")  # fmt: skip
+    for packages, required in (([f"scipy=={version('scipy')}", f"pillow=={version('pillow')}"],
+                                True), ([f"pykdtree=={version('pykdtree')}"], False)):  # fmt: skip
+        try:
+            _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
+                 "--only-binary=:all:", "--python-version", python, "--platform",
+                 PIP_PLATFORMS[platform], "-d", folder, *packages)  # fmt: skip
+        except subprocess.CalledProcessError:
+            if required:
+                raise
+            print(f"build: no {packages[0]} wheel for {platform}: SciPy's k-d tree is used")
     return sorted(set(folder.glob("*.whl")) - before)
 
 

@@ -91,7 +91,10 @@ def test_closest_points_on_triangles_match_dense_sampling():
     assert np.all(sampled - got <= edge * 0.02 + 1e-9)  # a sample lies within 0.02 edge
 
 
-def test_point_tree_finds_the_nearest_points_within_reach():
+@pytest.mark.parametrize("engine", ["pykdtree", "scipy"])
+def test_point_tree_finds_the_nearest_points_within_reach(engine, monkeypatch):
+    if engine == "scipy":  # the fallback where pykdtree is missing
+        monkeypatch.setattr(nearest, "KDTree", None)
     rng = np.random.default_rng(3)
     data, points = rng.random((500, 3)), rng.random((200, 3))
     tree = nearest.PointTree(data)

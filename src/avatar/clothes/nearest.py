@@ -3,7 +3,8 @@
 A posed frame builds one tree on the skin and asks it for the nearest vertices of every
 garment vertex, which makes this the hottest search of the clothes code. pykdtree (float32,
 OpenMP) answers it two to three times faster than scipy's cKDTree at these sizes (13,380
-skin vertices, a few hundred to ten thousand queries; see docs/benchmarks.md).
+skin vertices, a few hundred to ten thousand queries; see docs/benchmarks.md). Where it is
+missing (a Blender whose Python lacks it) scipy's tree answers the same queries.
 """
 
 from __future__ import annotations
@@ -12,7 +13,12 @@ import os
 from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
-from pykdtree.kdtree import KDTree
+from scipy.spatial import cKDTree
+
+try:
+    from pykdtree.kdtree import KDTree
+except ImportError:  # pragma: no cover - depends on the environment
+    KDTree = None  # type: ignore[misc, assignment]
 
 _BUILDER: list = []  # [(pid, executor)]: a forked child makes its own thread
 
@@ -22,7 +28,10 @@ class PointTree:
 
     def __init__(self, points: np.ndarray):
         self.points = np.ascontiguousarray(points, dtype=np.float32)
-        self._tree = KDTree(self.points, leafsize=16)
+        if KDTree is None:
+            self._tree = cKDTree(self.points, balanced_tree=False, compact_nodes=False)
+        else:
+            self._tree = KDTree(self.points, leafsize=16)
 
     @classmethod
     def later(cls, points: np.ndarray) -> Future[PointTree]:
@@ -43,5 +52,9 @@ class PointTree:
         k = 1, else (N, k). Beyond ``reach`` (m) a neighbour is missing: distance inf and
         index ``len(self)``, as in scipy."""
         p = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+        if isinstance(self._tree, cKDTree):
+            bound = np.inf if reach is None else reach
+            dist, index = self._tree.query(p, k=k, distance_upper_bound=bound, workers=-1)
+            return dist.astype(np.float32), index.astype(np.intp)
         dist, index = self._tree.query(p, k=k, distance_upper_bound=reach)
         return dist, index.astype(np.intp)
