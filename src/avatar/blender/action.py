@@ -13,7 +13,7 @@ from bpy_extras import anim_utils
 
 from avatar.rig.skeleton import Animation
 
-_LINEAR = 1  # Keyframe.interpolation enum value of 'LINEAR'
+CONSTANT, LINEAR = 0, 1  # Keyframe.interpolation enum values
 
 
 def apply_animation(
@@ -30,12 +30,7 @@ def apply_animation(
     Bones of the animation missing from the armature are skipped. The scene's frame range
     and fps are set to the clip's.
     """
-    action = bpy.data.actions.new(name)
-    slot = action.slots.new(id_type="OBJECT", name=armature_obj.name)
-    armature_obj.animation_data_create()
-    armature_obj.animation_data.action = action
-    armature_obj.animation_data.action_slot = slot
-    channelbag = anim_utils.action_ensure_channelbag_for_slot(action, slot)
+    action, channelbag = new_action(armature_obj, "OBJECT", name)
     frames = frame_start + np.arange(animation.frames, dtype=np.float32)
     for j, bone in enumerate(animation.bone_names):
         pose_bone = armature_obj.pose.bones.get(bone)
@@ -55,17 +50,35 @@ def apply_animation(
 def _write_channels(channelbag, group, bone: str, prop: str, frames, values) -> None:
     """values: (T, C) -> C F-curves ``pose.bones[bone].prop[c]`` keyed at ``frames`` (T,)."""
     path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{prop}'
-    count = len(frames)
     for c in range(values.shape[1]):
-        curve = channelbag.fcurves.new(path, index=c)
+        write_curve(channelbag, path, frames, values[:, c], LINEAR, index=c, group=group)
+
+
+def new_action(owner, id_type: str, name: str):
+    """A new action with one slot for ``owner`` (an Object, a Key, ...; ``id_type`` its
+    slot type, e.g. "OBJECT", "KEY"), assigned to it. Returns (action, its channelbag)."""
+    action = bpy.data.actions.new(name)
+    slot = action.slots.new(id_type=id_type, name=owner.name)
+    owner.animation_data_create()
+    owner.animation_data.action = action
+    owner.animation_data.action_slot = slot
+    return action, anim_utils.action_ensure_channelbag_for_slot(action, slot)
+
+
+def write_curve(channelbag, path: str, frames, values, interpolation: int, index: int = 0,
+                group=None) -> None:  # fmt: skip
+    """One F-curve ``path[index]`` keyed at ``frames`` (T,) with ``values`` (T,), written as
+    whole arrays; interpolation: LINEAR or CONSTANT."""
+    curve = channelbag.fcurves.new(path, index=index)
+    if group is not None:
         curve.group = group
-        points = curve.keyframe_points
-        points.add(count)
-        co = np.empty((count, 2), dtype=np.float32)
-        co[:, 0], co[:, 1] = frames, values[:, c]
-        points.foreach_set("co", co.ravel())
-        points.foreach_set("interpolation", np.full(count, _LINEAR, dtype=np.int32))
-        curve.update()
+    points = curve.keyframe_points
+    points.add(len(frames))
+    co = np.empty((len(frames), 2), dtype=np.float32)
+    co[:, 0], co[:, 1] = frames, values
+    points.foreach_set("co", co.ravel())
+    points.foreach_set("interpolation", np.full(len(frames), interpolation, dtype=np.int32))
+    curve.update()
 
 
 def set_frame_range(scene: bpy.types.Scene, start: int, count: int, fps: float) -> None:

@@ -13,11 +13,9 @@ from collections.abc import Sequence
 
 import bpy
 import numpy as np
-from bpy_extras import anim_utils
 
+from avatar.blender.action import CONSTANT, new_action, write_curve
 from avatar.errors import AvatarError
-
-_CONSTANT = 0  # Keyframe.interpolation enum value of 'CONSTANT'
 
 
 def apply_morph_weights(
@@ -44,32 +42,15 @@ def apply_morph_weights(
     moving = np.flatnonzero(np.any(weights != 0, axis=0))
     if not len(moving):
         return None
-    channelbag, action = _channelbag(keys, action_name)
+    action, channelbag = new_action(keys, "KEY", action_name)
     for k in moving:
         _write_steps(channelbag, names[k], weights[:, k], frame_start)
     return action
 
 
-def _channelbag(keys: bpy.types.Key, name: str):
-    """A new action with one KEY slot, assigned to ``keys``, and its channelbag."""
-    action = bpy.data.actions.new(name)
-    slot = action.slots.new(id_type="KEY", name=keys.name)
-    keys.animation_data_create()
-    keys.animation_data.action = action
-    keys.animation_data.action_slot = slot
-    return anim_utils.action_ensure_channelbag_for_slot(action, slot), action
-
-
 def _write_steps(channelbag, name: str, values: np.ndarray, frame_start: int) -> None:
     """One CONSTANT F-curve ``key_blocks[name].value`` keyed at the first frame and wherever
     ``values`` (T,) changes; constant extrapolation holds the ends."""
-    changes = np.flatnonzero(np.diff(values) != 0) + 1
-    at = np.concatenate([[0], changes])
-    co = np.empty((len(at), 2), dtype=np.float32)
-    co[:, 0], co[:, 1] = frame_start + at, values[at]
-    curve = channelbag.fcurves.new(f'key_blocks["{bpy.utils.escape_identifier(name)}"].value')
-    points = curve.keyframe_points
-    points.add(len(at))
-    points.foreach_set("co", co.ravel())
-    points.foreach_set("interpolation", np.full(len(at), _CONSTANT, dtype=np.int32))
-    curve.update()
+    at = np.concatenate([[0], np.flatnonzero(np.diff(values) != 0) + 1])
+    path = f'key_blocks["{bpy.utils.escape_identifier(name)}"].value'
+    write_curve(channelbag, path, frame_start + at, values[at], CONSTANT)

@@ -270,8 +270,9 @@ class PosedBody:
         close = np.stack([w[rows, best] for w in close], axis=1).astype(np.float32)
         triangle = cand[rows, best]
         n = self._interpolated_normals(corner[:, rows, best], bary.T)
-        distance = np.sqrt(_dot3((p - close).T, (p - close).T))
-        distance = np.where(_dot3((p - close).T, n.T) < 0, -distance, distance)
+        offset = (p - close).T
+        distance = np.sqrt(_dot3(offset, offset))
+        distance = np.where(_dot3(offset, n.T) < 0, -distance, distance)
         return SurfaceQuery(distance.astype(np.float32), close, n, near[:, 0].astype(np.int32),
                             triangle.astype(np.int32), bary)  # fmt: skip
 
