@@ -27,3 +27,17 @@ def fixtures() -> Path:
     if not FIXTURES.is_dir():
         pytest.skip(f"shared fixtures not found at {FIXTURES}")
     return FIXTURES
+
+
+@pytest.fixture(scope="session")
+def heavy_walker(model):
+    """seconds -> (a heavy human in a T-shirt and jeans, its walk of that length): the bake
+    tests' case. game_engine rig: at most 8 influences, so a file's body is Avatar's."""
+    import avatar
+
+    def make(seconds: float):
+        human = avatar.Human({"weight": 0.8, "gender": 0.3}, rig="game_engine", model=model)
+        human = human.dressed("tshirt", "jeans")
+        return human, avatar.walk(human, seconds=seconds, fps=30)
+
+    return make

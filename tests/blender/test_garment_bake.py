@@ -14,13 +14,8 @@ GARMENTS = ("tshirt", "jeans")
 
 
 @pytest.fixture(scope="module")
-def dressed(model):
-    """A heavy walker (the bake test's human), a short clip."""
-    import avatar
-
-    human = avatar.Human({"weight": 0.8, "gender": 0.3}, rig="game_engine", model=model)
-    human = human.dressed(*GARMENTS)
-    return human, avatar.walk(human, seconds=0.3, fps=30)
+def dressed(heavy_walker):
+    return heavy_walker(0.3)
 
 
 def _exact_frames(human, walk, frames):

@@ -22,11 +22,8 @@ GARMENTS = ("tshirt", "jeans")
 
 
 @pytest.fixture(scope="module")
-def dressed(model):
-    """A heavy walker (game_engine: at most 8 influences, so the file's body is Avatar's)."""
-    human = avatar.Human({"weight": 0.8, "gender": 0.3}, rig="game_engine", model=model)
-    human = human.dressed(*GARMENTS)
-    return human, avatar.walk(human, seconds=0.5, fps=30)
+def dressed(heavy_walker):
+    return heavy_walker(0.5)
 
 
 @pytest.fixture(scope="module")
