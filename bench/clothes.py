@@ -26,7 +26,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 import avatar
-from avatar.clothes import collision, fitting, library
+from avatar.clothes import fitting, library
+from avatar.geometry import collision
 from avatar.rig import kinematics, skinning
 
 OUTFITS = [("tshirt", "jeans", "socks", "shoes", "cap"),

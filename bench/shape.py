@@ -179,7 +179,7 @@ def report(name: str, seconds: float, calls: int, per: int = 1) -> None:
 
 def time_cache() -> None:
     """Cold build into a temporary AVATAR_CACHE (compile + attribute basis), then warm loads."""
-    from avatar import assets
+    from avatar.body import assets
     from avatar.body.attributes import basis
     from avatar.body.model import BodyModel
 

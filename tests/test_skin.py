@@ -7,8 +7,9 @@ import time
 import numpy as np
 import pytest
 
-from avatar import assets, skin
+from avatar.body import assets
 from avatar.errors import AssetError
+from avatar.looks import skin
 
 
 def _luma(rgb) -> float:

@@ -200,7 +200,7 @@ def parse_assignments(items: Sequence[str]) -> dict[str, float]:
 
 
 def run_create(args: argparse.Namespace) -> int:
-    from avatar import assets
+    from avatar.body import assets
     from avatar.body.model import BodyModel
     from avatar.export import save
     from avatar.human import Human
@@ -264,7 +264,7 @@ def _animation(human, args: argparse.Namespace):
 
 
 def run_info(args: argparse.Namespace) -> int:
-    from avatar import assets
+    from avatar.body import assets
     from avatar.body.model import BodyModel
 
     compiled = assets.load(progress=True)

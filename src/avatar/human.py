@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from avatar.assets import RIG_NAMES
+from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.errors import ParameterError, unknown_name
 from avatar.mesh import Mesh
@@ -224,7 +224,7 @@ class Human:
 
     def material(self, part: str):
         """The generated material of a body part (procedural skin or eye)."""
-        from avatar import skin
+        from avatar.looks import skin
 
         p = self.model.defaults() | self.recipe.params
         if part == "eyes":
@@ -262,7 +262,7 @@ class Human:
 
 def _eye_uvs(mesh: Mesh, faces: np.ndarray, base: Mesh) -> Mesh:
     """The eyes with UVs spread over the procedural eye texture (one texture, both eyes)."""
-    from avatar import skin
+    from avatar.looks import skin
 
     assert mesh.uvs is not None and mesh.face_uvs is not None
     left = np.isin(faces, base.face_groups["helper-l-eye"])

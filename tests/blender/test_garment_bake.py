@@ -45,7 +45,8 @@ def test_blend_export_plays_the_exact_frames_with_no_garment_inside(empty_scene,
 
     import avatar
     from avatar.blender import mesh
-    from avatar.clothes import collision, fitting
+    from avatar.clothes import fitting
+    from avatar.geometry import collision
 
     human, walk = dressed
     avatar.save(human, tmp_path / "walk.blend", walk)  # the scene it wrote stays open

@@ -12,7 +12,8 @@ import pytest
 from gltf_player import Player
 
 import avatar
-from avatar.clothes import bake, collision, fitting
+from avatar.clothes import bake, fitting
+from avatar.geometry import collision
 from avatar.io import gltf
 from avatar.rig import kinematics, skinning
 

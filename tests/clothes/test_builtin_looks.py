@@ -5,9 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar.clothes import builtin, collision, face, hair, library, textures
-from avatar.clothes.shell import boundary_edges
+from avatar.clothes import builtin, face, hair, library
+from avatar.geometry import collision
+from avatar.geometry.shell import boundary_edges
 from avatar.human import Human
+from avatar.looks import textures
 
 
 @pytest.fixture(scope="module")

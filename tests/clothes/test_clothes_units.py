@@ -7,10 +7,12 @@ import shutil
 import numpy as np
 import pytest
 
-from avatar.clothes import binding, collision, fabrics, nearest, shell, weights
+from avatar.clothes import binding, weights
 from avatar.clothes.binder import bind, save
 from avatar.clothes.scan import scan
 from avatar.errors import AvatarError, FormatError
+from avatar.geometry import collision, nearest, shell
+from avatar.looks import fabrics
 from avatar.mesh import Mesh
 from avatar.rig.skinning import SkinWeights
 

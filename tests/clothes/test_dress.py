@@ -7,8 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avatar.clothes import binding, collision, library
+from avatar.clothes import binding, library
 from avatar.errors import FormatError
+from avatar.geometry import collision
 from avatar.human import Human
 from avatar.io import mhclo, obj
 

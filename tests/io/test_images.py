@@ -11,7 +11,7 @@ import zlib
 import numpy as np
 import pytest
 
-from avatar import assets
+from avatar.body import assets
 from avatar.errors import AssetError, FormatError
 from avatar.io import images, png
 

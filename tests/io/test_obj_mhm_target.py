@@ -7,9 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from avatar.assets import parse_target
 from avatar.errors import FormatError
 from avatar.io import mhm, obj
+from avatar.io.target import loads as parse_target
 from avatar.mesh import Mesh
 
 QUAD = Mesh(
@@ -120,7 +120,7 @@ def test_target_fuzz_only_raises_format_error(text):
 
 
 def test_rig_json_errors_are_format_errors(tmp_path):
-    from avatar.assets import _read_json
+    from avatar.body.assets import _read_json
 
     (tmp_path / "rig.x.json").write_text('{"a": \n  [1, 2,, ]}')
     with pytest.raises(FormatError) as info:

@@ -95,7 +95,7 @@ def test_a_chain_has_no_hips():
 
 
 def test_avatar_rigs_by_topology_match_names(model):
-    from avatar.assets import RIG_NAMES
+    from avatar.body.assets import RIG_NAMES
     from avatar.human import Human
 
     for rig in RIG_NAMES:

@@ -174,7 +174,7 @@ def test_library_folders_names_and_env(tmp_path, monkeypatch, skeletons):
 def test_mpfb_pose_onto_another_rig_through_the_reference(skeletons):
     """MPFB's T-pose names the default rig's bones; on mixamo it goes through the
     retargeter and still raises the arms."""
-    from avatar import assets
+    from avatar.body import assets
 
     meta = assets.load().meta["poses"]
     if "default" not in meta:

@@ -19,7 +19,7 @@ TOOLS = ("blender", "Xvfb", "xdotool")
 
 def _assets_available() -> bool:
     try:
-        from avatar import assets
+        from avatar.body import assets
 
         assets.find_data_dir()
     except Exception:  # noqa: BLE001 - any failure means: nothing to create a human from

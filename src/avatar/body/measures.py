@@ -15,10 +15,10 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from avatar.body.model import BODY_VERTICES
 from avatar.mesh import Mesh
 
 NIPPLES = (8451, 1779)  # the default rig's breast tails: MakeHuman's nipple vertices
-BODY = 13380
 
 
 @dataclass(frozen=True)
@@ -110,11 +110,11 @@ def _hull_perimeter(p: np.ndarray) -> float:
 def measure(vertices: np.ndarray, mesh: Mesh | None = None) -> dict[str, float]:
     """height, chest, waist and hips (metres) of a body's vertices (19158, 3)."""
     if mesh is None:
-        from avatar import assets
+        from avatar.body import assets
 
         mesh = assets.load().base
     tri = mesh.with_vertices(vertices).subset(mesh.face_groups["body"]).triangles()
-    body = vertices[:BODY]
+    body = vertices[:BODY_VERTICES]
     lm = landmarks(vertices, mesh.groups)
     hips_z = np.linspace(lm.pelvis - 0.06, lm.navel, 9)
     waist_z = np.linspace(lm.waist_low, lm.chest - 0.06, 9)

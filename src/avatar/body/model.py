@@ -24,8 +24,7 @@ from functools import cached_property
 import numpy as np
 from scipy.linalg import blas
 
-from avatar import assets
-from avatar.body import macros
+from avatar.body import assets, macros
 from avatar.body.modifiers import Modifier, modifiers_from_target_json
 from avatar.errors import ParameterError, unknown_name
 from avatar.mesh import Mesh

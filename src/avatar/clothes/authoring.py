@@ -14,13 +14,12 @@ from functools import cached_property
 import numpy as np
 from scipy.spatial import cKDTree
 
+from avatar.body.model import BODY_VERTICES
 from avatar.clothes import regions
 from avatar.clothes.binder import bind
 from avatar.clothes.binding import Binding, make_binding
-from avatar.clothes.fabrics import TILE_METRES
+from avatar.looks.fabrics import TILE_METRES
 from avatar.mesh import Mesh, vertex_normals
-
-SKIN = 13380
 
 
 class AuthoringBody:
@@ -39,11 +38,11 @@ class AuthoringBody:
 
     @cached_property
     def skin_normals(self) -> np.ndarray:
-        return vertex_normals(self.vertices[:SKIN].astype(np.float32), self.skin_faces)
+        return vertex_normals(self.vertices[:BODY_VERTICES].astype(np.float32), self.skin_faces)
 
     @cached_property
     def skin_tree(self) -> cKDTree:
-        return cKDTree(self.vertices[:SKIN])
+        return cKDTree(self.vertices[:BODY_VERTICES])
 
     def outward(self, points: np.ndarray) -> np.ndarray:
         """(N, 3) skin normal at the nearest skin vertex: 'away from the body' everywhere."""
@@ -120,7 +119,7 @@ def relax_boundary(
     surface's tangent plane at the vertex's original position (normals (N, 3)).
     Vertices where two loops touch stay put.
     """
-    from avatar.clothes.shell import boundary_edges
+    from avatar.geometry.shell import boundary_edges
 
     edges, _ = boundary_edges(faces)
     count = len(points)
@@ -284,5 +283,5 @@ def _pad(a: np.ndarray, width: int) -> np.ndarray:
 def covered_skin(body: AuthoringBody, mesh: Mesh, reach: float = 0.02) -> np.ndarray:
     """(D,) int32 skin vertices within ``reach`` of the garment (to hide if the user asks)."""
     tree = cKDTree(mesh.vertices)
-    d, _ = tree.query(body.vertices[:SKIN], distance_upper_bound=reach)
+    d, _ = tree.query(body.vertices[:BODY_VERTICES], distance_upper_bound=reach)
     return np.flatnonzero(np.isfinite(d)).astype(np.int32)

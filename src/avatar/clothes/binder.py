@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from avatar.clothes import collision
 from avatar.clothes.binding import Binding, axis_scale, make_binding
 from avatar.errors import AvatarError
+from avatar.geometry import collision
 from avatar.io import mhclo, mhmat, obj
 from avatar.mesh import Mesh
 

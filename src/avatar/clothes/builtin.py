@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar.clothes import fabrics, face, hair, textures
+from avatar.clothes import face, hair
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -24,6 +24,7 @@ from avatar.clothes.authoring import (
 )
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
+from avatar.looks import fabrics, textures
 
 RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
 

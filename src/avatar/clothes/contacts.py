@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar.clothes import collision
+from avatar.geometry import collision
 
 REMOTE_K = 3  # nearest skin vertices whose rest places tell another body part
 CLOSING = 0.01  # m that skin may come closer to a point's anchor before it is another part

@@ -7,7 +7,7 @@ import numpy as np
 
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, single_references
 from avatar.clothes.hair import per_corner
-from avatar.clothes.shell import boundary_edges
+from avatar.geometry.shell import boundary_edges
 from avatar.mesh import Mesh
 
 

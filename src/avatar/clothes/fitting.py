@@ -17,17 +17,17 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
-from avatar.clothes import collision, weights
+from avatar.clothes import weights
 from avatar.clothes.binding import Binding, fit
 from avatar.clothes.contacts import remote_contacts
 from avatar.clothes.outfit import Outfit
-from avatar.clothes.shell import Shell, extrude, solidify
+from avatar.geometry import collision
+from avatar.geometry.shell import Shell, extrude, solidify
 from avatar.io.mhw import BoneWeights
 from avatar.material import Material
 from avatar.mesh import Mesh
 from avatar.rig.skinning import SkinWeights
 
-BODY_VERTEX_COUNT = BODY_VERTICES  # hm08 skin; helpers follow
 CLEARANCE = 0.002  # m between skin and a garment's inside
 LAYER_GAP = 0.0015  # m between stacked garments
 FLOOR_REACH = 0.04  # m; garment parts further out (loose hems, hair ends) define no layer
@@ -116,7 +116,7 @@ def body_surface(faces: np.ndarray) -> collision.BodySurface:
         return _LAST_SURFACE[0][1]
     key = faces
     faces = np.asarray(faces, dtype=np.int32)
-    skin = faces[(faces < BODY_VERTEX_COUNT).all(axis=1)]
+    skin = faces[(faces < BODY_VERTICES).all(axis=1)]
     surface = _surface_cached(np.ascontiguousarray(skin).tobytes(), skin.shape)
     _LAST_SURFACE[:] = [(key, surface)]  # holds the faces array: its id cannot be reused
     return surface
@@ -127,8 +127,8 @@ class Pose(collision.PosedBody):
     layer floors of the garments fitted on it so far."""
 
     def __init__(self, surface: collision.BodySurface, vertices: np.ndarray):
-        super().__init__(surface, vertices[:BODY_VERTEX_COUNT], tree_now=True)
-        self.floor = np.zeros(BODY_VERTEX_COUNT, np.float32)
+        super().__init__(surface, vertices[:BODY_VERTICES], tree_now=True)
+        self.floor = np.zeros(BODY_VERTICES, np.float32)
 
     def query_near(self, points: np.ndarray) -> collision.SurfaceQuery:
         """Closest skin of points: one vertex ring each, four rings near the skin.

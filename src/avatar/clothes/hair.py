@@ -15,22 +15,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import (
-    SKIN,
     AuthoringBody,
     Piece,
     bound,
     cut,
     orient_outward,
 )
-from avatar.clothes.shell import boundary_edges
+from avatar.geometry.shell import boundary_edges
 from avatar.mesh import Mesh
 
 
 def eye_level(body: AuthoringBody) -> tuple[np.ndarray, float]:
     """(head centre (3,), eye height z) of the authoring body."""
     left, right = body.centre("helper-l-eye"), body.centre("helper-r-eye")
-    head = body.vertices[:SKIN][body.part[:SKIN] == "head"]
+    head = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"]
     centre = np.array([0.0, head[:, 1].mean(), (left[2] + right[2]) / 2])
     return centre, float(centre[2])
 
@@ -92,7 +92,7 @@ def head_frame(body: AuthoringBody) -> tuple[np.ndarray, float]:
     """(centre of the skull (3,), eye height z): the middle of the head's front-to-back and
     side-to-side extent at eye height (the face's dense vertices do not pull it forward)."""
     _, eye_z = eye_level(body)
-    head = body.vertices[:SKIN][body.part[:SKIN] == "head"]
+    head = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"]
     y = (head[:, 1].min() + head[:, 1].max()) / 2
     return np.array([0.0, y, eye_z]), eye_z
 
@@ -336,7 +336,7 @@ def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 60, seed: in
     gathered tight at the tie, fuller below it and tapering to the tips."""
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
-    back = body.vertices[:SKIN][body.part[:SKIN] == "head"][:, 1].max()
+    back = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"][:, 1].max()
     root = np.array([0.0, back + 0.005, eye_z + 0.02])
     k = 13
     t = np.linspace(0, 1, k)

@@ -15,14 +15,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
-from avatar.clothes import collision
 from avatar.clothes.contacts import remote_contacts
+from avatar.geometry import collision
 from avatar.rig.skinning import SkinWeights, linear_blend
 
 if TYPE_CHECKING:
     from avatar.clothes.fitting import FittedGarment
 
-BODY_VERTEX_COUNT = BODY_VERTICES
 
 
 @dataclass(eq=False)
@@ -73,7 +72,7 @@ class Outfit:
 
     def posed_body(self, body_posed: np.ndarray) -> collision.PosedBody:
         """The skin of a posed body (V, 3) as a collider for this outfit's garments."""
-        return collision.PosedBody(self.surface, body_posed[:BODY_VERTEX_COUNT], tree_now=True)
+        return collision.PosedBody(self.surface, body_posed[:BODY_VERTICES], tree_now=True)
 
     def _escape(self, skin: collision.PosedBody, vertices: list[np.ndarray]) -> list[np.ndarray]:
         """Each colliding garment's vertices (M_i, 3) with any inside the skin moved out of

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from avatar.body.model import BODY_VERTICES
 from avatar.errors import AvatarError
 from avatar.rig import quaternion
 from avatar.rig.skeleton import Animation, Skeleton
@@ -99,11 +100,12 @@ def _arm_hang(skeleton: Skeleton, side: str, degrees: float) -> np.ndarray:
 def _clear_hang(human: Human, side: str) -> float:
     """Degrees out from straight down (ARM_HANG..45, in 3-degree steps) at which the arm's
     skin, grown by ARM_ROOM, is first outside the body, posed by linear blend skinning."""
-    from avatar.clothes import collision, fitting
+    from avatar.clothes import fitting
+    from avatar.geometry import collision
     from avatar.rig import kinematics, skinning
 
     skeleton, weights = human.skeleton, human.weights
-    skin = fitting.BODY_VERTEX_COUNT
+    skin = BODY_VERTICES
     arm = [i for i, n in enumerate(skeleton.names) if n.endswith(side) and n.startswith(ARM_BONES)]
     share = np.isin(weights.indices[:skin], arm) * weights.weights[:skin]
     points = np.flatnonzero(share.sum(axis=1) > 0.95)  # the arm itself, not the shoulder

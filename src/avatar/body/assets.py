@@ -65,7 +65,6 @@ def extra_data_dir(name: str) -> Path | None:
 
 # ----------------------------------------------------------------------------- compilation
 
-import gzip  # noqa: E402
 import hashlib  # noqa: E402
 import json  # noqa: E402
 import logging  # noqa: E402
@@ -78,6 +77,7 @@ from functools import cached_property  # noqa: E402
 import numpy as np  # noqa: E402
 
 from avatar.errors import FormatError  # noqa: E402
+from avatar.io import target  # noqa: E402
 from avatar.mesh import Mesh  # noqa: E402
 
 log = logging.getLogger(__name__)
@@ -110,64 +110,6 @@ def fingerprint(data_dir: Path) -> str:
                 st = path.stat()
                 h.update(f"{path.relative_to(root)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
     return h.hexdigest()[:16]
-
-
-def parse_target(text: str, path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Parse MakeHuman ``.target`` text (``index dx dy dz`` lines, dm, Y-up).
-
-    Returns (index (n,) int32, delta (n, 3) float32 in Avatar's frame: metres, Z-up).
-    """
-    rows: list[str] = []
-    for lineno, line in enumerate(text.splitlines(), 1):
-        s = line.strip()
-        if not s or s.startswith("#"):
-            continue
-        fields = s.split()
-        if len(fields) != 4:
-            raise FormatError(path, lineno, f"expected 'index dx dy dz', got {s[:60]!r}")
-        rows.append(s)
-    if not rows:
-        return np.zeros(0, np.int32), np.zeros((0, 3), np.float32)
-    try:
-        table = np.array(" ".join(rows).split(), dtype=np.float64).reshape(-1, 4)
-    except ValueError:
-        for lineno, line in enumerate(text.splitlines(), 1):
-            s = line.strip()
-            if s and not s.startswith("#"):
-                try:
-                    [float(x) for x in s.split()]
-                except ValueError:
-                    raise FormatError(path, lineno, f"non-numeric value in {s[:60]!r}") from None
-        raise
-    index = table[:, 0]
-    bad = ~np.isfinite(table).all(axis=1) | (index < 0) | (index != np.round(index))
-    if bad.any():
-        bad_line = _data_line(text, int(np.argmax(bad)))
-        raise FormatError(path, bad_line, "bad index or non-finite offset")
-    d = table[:, 1:]
-    delta = np.stack([d[:, 0], -d[:, 2], d[:, 1]], axis=1) * 0.1
-    return table[:, 0].astype(np.int32), delta.astype(np.float32)
-
-
-def _data_line(text: str, k: int) -> int:
-    """1-based line number of the k-th data line."""
-    seen = -1
-    for lineno, line in enumerate(text.splitlines(), 1):
-        s = line.strip()
-        if s and not s.startswith("#"):
-            seen += 1
-            if seen == k:
-                return lineno
-    return 0
-
-
-def read_target(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Read a ``.target`` or ``.target.gz`` file (see ``parse_target``)."""
-    try:
-        raw = gzip.decompress(path.read_bytes()) if path.suffix == ".gz" else path.read_bytes()
-    except (OSError, EOFError, gzip.BadGzipFile) as exc:
-        raise FormatError(path, 0, f"cannot read target: {exc}") from None
-    return parse_target(raw.decode("utf-8", errors="replace"), path)
 
 
 @dataclass(frozen=True)
@@ -312,7 +254,7 @@ def _compile_targets(root: Path, arrays: dict[str, np.ndarray], meta: dict, prog
         items = tqdm(names, desc="compiling MakeHuman targets", unit="target")
     index, delta = [], []
     for name in items:
-        i, d = read_target(files[name])
+        i, d = target.read(files[name])
         if len(i) and i.max() >= 19158:
             raise AssetError(f"{files[name]}: vertex index {i.max()} beyond the base mesh")
         index.append(i)

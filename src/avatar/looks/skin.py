@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar import assets
+from avatar.body import assets
 from avatar.io import images
 from avatar.material import Material
 

@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar.clothes import fabrics
+from avatar.looks import fabrics
 from avatar.material import Material
 
 
