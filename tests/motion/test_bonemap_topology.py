@@ -11,8 +11,9 @@ import pytest
 
 from avatar.errors import ParameterError
 from avatar.io import bvh
-from avatar.motion import bonemap, geometry, topology
+from avatar.motion import bonemap, geometry
 from avatar.motion.retarget import retarget
+from avatar.rig import topology
 from avatar.rig.kinematics import forward
 from avatar.rig.skeleton import Animation, Skeleton
 

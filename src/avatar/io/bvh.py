@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import FormatError, ParameterError
-from avatar.rig import quaternion
+from avatar.rig import quaternion, topology
 from avatar.rig.placement import rest_matrices
 from avatar.rig.skeleton import Animation, Skeleton
 
@@ -490,8 +490,6 @@ def _head_and_feet(data: BvhData) -> tuple[int, list[int]] | None:
     feet = _named(data, ("foot", "footl", "footr", "ankle", "anklel", "ankler"))
     if heads and len(feet) >= 2:
         return heads[0], feet
-    from avatar.motion import topology  # lazy: motion imports this module
-
     poses = world_positions(data, _sample(data, 16)) if data.frames else None
     roles = topology.upright_roles(data.parents, data.offsets, poses)
     if roles is None:

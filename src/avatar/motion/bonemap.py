@@ -11,7 +11,7 @@ shape can be passed anywhere a convention name is accepted. Names match case-ins
 after dropping any ``prefix:`` (``mixamorig:Hips``, ``mixamorig1:Hips``).
 
 When names match no convention well (any body bone missing), the roles are inferred from
-the hierarchy and geometry (``avatar.motion.topology``): fully when names found under half
+the hierarchy and geometry (``avatar.rig.topology``): fully when names found under half
 of the body bones, otherwise only the missing ones; ``BoneMap.inferred`` says which.
 """
 
@@ -29,7 +29,7 @@ from types import MappingProxyType
 import numpy as np
 
 from avatar.errors import FormatError, ParameterError, unknown_name
-from avatar.motion import topology
+from avatar.rig import topology
 from avatar.rig.skeleton import Skeleton
 
 _TRUNK = {"hips": "spine", "spine": "chest", "chest": "neck", "neck": "head", "head": None}
