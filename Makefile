@@ -1,5 +1,6 @@
 # The README's two commands: `make demo` (the main job) and `make test` (the test suite).
-# Both set up everything they need on a fresh machine first (scripts/setup.sh).
+# Both set up everything they need on a fresh machine first (scripts/setup.sh); `make test`
+# runs the style checks (`make lint`: ruff, mypy) before the tests.
 VENV := .venv/bin
 OUT ?= out
 
@@ -14,11 +15,14 @@ demo: setup
 		--motion walk -o $(OUT)/demo.glb --render $(OUT)/demo.png
 	@echo "wrote $(OUT)/demo.glb and $(OUT)/demo.png"
 
-test: setup
+# The tests start with the style checks (lint): any ruff or mypy finding fails `make test`.
+test: lint
 	$(VENV)/python -m pytest -q -x --timeout=900
 
+# ruff (rules in pyproject.toml: layering bans bpy outside avatar.blender, no print in the
+# library) and mypy (src/avatar, configured in pyproject.toml).
 lint: setup
-	$(VENV)/ruff check src tests bench
+	$(VENV)/ruff check src tests bench addon
 	$(VENV)/mypy
 
 bench: setup
