@@ -9,81 +9,18 @@ where the per-axis scale S compares the body's extent along axis k between two r
 vertices ``p_k, q_k`` with the same extent ``L_k`` on the body the garment was authored on
 (MakeHuman 1.1 ``proxy.TMatrix``). Everything here is in Avatar's frame (metres, Z-up); the
 ``.mhclo`` reader converts MakeHuman's decimetre Y-up numbers once.
+
+The record itself (``Binding``, built by ``make_binding``) lives with its file format in
+``avatar.io.mhclo``, so that io needs nothing from clothes; it is re-exported here.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from avatar.io.mhclo import Binding, make_binding
 
-@dataclass(frozen=True)
-class Binding:
-    """A garment's attachment to the body (N garment vertices).
-
-    indices: (N, 3) int32 body vertex indices (a single-vertex reference repeats its index).
-    weights: (N, 3) float64 barycentric weights; (1, 0, 0) for single-vertex references.
-    offsets: (N, 3) float64 offsets in metres, Avatar axes, before scaling.
-    single: (N,) bool, True where the vertex was stored as a single-vertex reference.
-    scale_refs: (3, 2) int32 body vertex pair measuring each Avatar axis (x, y, z);
-        (-1, -1) for an axis without scaling (S = 1).
-    scale_lengths: (3,) float64 the pair's extent along that axis on the authoring body (m).
-    """
-
-    indices: np.ndarray
-    weights: np.ndarray
-    offsets: np.ndarray
-    single: np.ndarray
-    scale_refs: np.ndarray
-    scale_lengths: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.indices.shape[0])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Binding):
-            return NotImplemented
-        return all(
-            np.array_equal(getattr(self, k), getattr(other, k))
-            for k in ("indices", "weights", "offsets", "single", "scale_refs", "scale_lengths")
-        )
-
-    __hash__ = None  # type: ignore[assignment]
-
-    def subset(self, index: np.ndarray) -> Binding:
-        """The binding of the garment vertices ``index`` only (e.g. after dropping faces)."""
-        return Binding(
-            self.indices[index],
-            self.weights[index],
-            self.offsets[index],
-            self.single[index],
-            self.scale_refs,
-            self.scale_lengths,
-        )
-
-
-def make_binding(
-    indices: np.ndarray,
-    weights: np.ndarray,
-    offsets: np.ndarray,
-    scale_refs: np.ndarray | None = None,
-    scale_lengths: np.ndarray | None = None,
-    single: np.ndarray | None = None,
-) -> Binding:
-    """A Binding from array-likes, with dtypes and shapes normalised (no scaling by default)."""
-    indices = np.asarray(indices, dtype=np.int32).reshape(-1, 3)
-    n = len(indices)
-    refs = np.full((3, 2), -1, np.int32) if scale_refs is None else scale_refs
-    lengths = np.ones(3) if scale_lengths is None else scale_lengths
-    return Binding(
-        indices=indices,
-        weights=np.asarray(weights, dtype=np.float64).reshape(n, 3),
-        offsets=np.asarray(offsets, dtype=np.float64).reshape(n, 3),
-        single=np.zeros(n, bool) if single is None else np.asarray(single, bool).reshape(n),
-        scale_refs=np.asarray(refs, dtype=np.int32).reshape(3, 2),
-        scale_lengths=np.asarray(lengths, dtype=np.float64).reshape(3),
-    )
+__all__ = ["Binding", "axis_scale", "fit", "make_binding"]
 
 
 def axis_scale(binding: Binding, body_vertices: np.ndarray) -> np.ndarray:

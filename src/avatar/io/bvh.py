@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import FormatError, ParameterError
+from avatar.io import atomic
 from avatar.rig import quaternion, topology
 from avatar.rig.placement import rest_matrices
 from avatar.rig.skeleton import Animation, Skeleton
@@ -344,8 +345,8 @@ def _write_joint(out, data: BvhData, children, j: int, depth: int, precision: in
 
 
 def write(path: str | os.PathLike[str], data: BvhData, precision: int = 6) -> None:
-    """Write ``data`` as a BVH file."""
-    Path(path).write_text(dumps(data, precision), encoding="utf-8")
+    """Write ``data`` as a BVH file (atomically: a temporary file renamed into place)."""
+    atomic.write_text(path, dumps(data, precision))
 
 
 # ----------------------------------------------------------------------------- conversion

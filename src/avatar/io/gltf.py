@@ -20,10 +20,9 @@ original vertex array, skin and morphs exactly.
 from __future__ import annotations
 
 import base64
-import contextlib
 import logging
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,8 +30,8 @@ import numpy as np
 import pygltflib as g
 
 from avatar.errors import FormatError
+from avatar.io import atomic, gltf_materials, gltf_morphs, gltf_skin
 from avatar.io import gltf_accessors as acc
-from avatar.io import gltf_materials, gltf_morphs, gltf_skin
 from avatar.mesh import Mesh, vertex_normals
 from avatar.part import MeshPart
 from avatar.rig.skeleton import Animation, Skeleton
@@ -111,30 +110,15 @@ def _save(gltf: g.GLTF2, blob: bytes, path: Path, embed: bool) -> None:
     gltf.buffers.append(buffer)
     if path.suffix.lower() == ".glb":
         gltf.set_binary_blob(blob)
-        _atomic({path: lambda tmp: gltf.save_binary(str(tmp))})
+        atomic.write_all({path: lambda tmp: gltf.save_binary(str(tmp))})
         return
     if embed:
         buffer.uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode()
-        _atomic({path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})
+        atomic.write_all({path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})
         return
     buffer.uri = path.with_suffix(".bin").name
-    _atomic({path.with_suffix(".bin"): lambda tmp: tmp.write_bytes(blob),
-             path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})  # fmt: skip
-
-
-def _atomic(writers: dict[Path, Callable[[Path], object]]) -> None:
-    """Call each ``write(tmp)`` on a temporary path beside its file, then rename them all
-    into place: nothing is replaced unless every file was written."""
-    temps = {path: path.with_name(f".{path.name}.{os.getpid()}.part") for path in writers}
-    try:
-        for path, write in writers.items():
-            write(temps[path])
-        for path, tmp in temps.items():
-            os.replace(tmp, path)
-    finally:
-        for tmp in temps.values():
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
+    atomic.write_all({path.with_suffix(".bin"): lambda tmp: tmp.write_bytes(blob),
+                      path: lambda tmp: tmp.write_text(gltf.gltf_to_json())})  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- geometry

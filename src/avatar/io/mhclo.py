@@ -7,6 +7,9 @@ three weights and an optional offset ``dx dy dz`` (decimetres, Y-up). ``x_scale 
 vertices to hide, ``a - b`` meaning the inclusive range. Keyword lines may appear anywhere,
 including between reference lines (MakeHuman checks keywords before the section state).
 
+``Binding`` (the reference lines as arrays) is defined here, with its format, and used by
+``avatar.clothes.binding``, which evaluates it on a body.
+
 Reading converts to Avatar's frame once (``Binding`` is in metres, Z-up); writing converts
 back and chooses, per number, the shortest decimal that reads back to the same float, so
 ``read(write(p)) == p`` exactly.
@@ -20,13 +23,81 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar.clothes.binding import Binding, make_binding
 from avatar.errors import FormatError
+from avatar.io import atomic
 
 BASE_VERTEX_COUNT = 19158  # hm08
 # MakeHuman scale line -> the Avatar axis it measures (x -> x, y-up -> z, z-forward -> y).
 _MH_TO_AVATAR = {"x_scale": 0, "y_scale": 2, "z_scale": 1}
 _STRING_KEYS = ("name", "uuid", "basemesh", "obj_file", "material", "vertexboneweights_file")
+
+
+@dataclass(frozen=True)
+class Binding:
+    """A garment's attachment to the body (N garment vertices).
+
+    indices: (N, 3) int32 body vertex indices (a single-vertex reference repeats its index).
+    weights: (N, 3) float64 barycentric weights; (1, 0, 0) for single-vertex references.
+    offsets: (N, 3) float64 offsets in metres, Avatar axes, before scaling.
+    single: (N,) bool, True where the vertex was stored as a single-vertex reference.
+    scale_refs: (3, 2) int32 body vertex pair measuring each Avatar axis (x, y, z);
+        (-1, -1) for an axis without scaling (S = 1).
+    scale_lengths: (3,) float64 the pair's extent along that axis on the authoring body (m).
+    """
+
+    indices: np.ndarray
+    weights: np.ndarray
+    offsets: np.ndarray
+    single: np.ndarray
+    scale_refs: np.ndarray
+    scale_lengths: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.indices.shape[0])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Binding):
+            return NotImplemented
+        return all(
+            np.array_equal(getattr(self, k), getattr(other, k))
+            for k in ("indices", "weights", "offsets", "single", "scale_refs", "scale_lengths")
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def subset(self, index: np.ndarray) -> Binding:
+        """The binding of the garment vertices ``index`` only (e.g. after dropping faces)."""
+        return Binding(
+            self.indices[index],
+            self.weights[index],
+            self.offsets[index],
+            self.single[index],
+            self.scale_refs,
+            self.scale_lengths,
+        )
+
+
+def make_binding(
+    indices: np.ndarray,
+    weights: np.ndarray,
+    offsets: np.ndarray,
+    scale_refs: np.ndarray | None = None,
+    scale_lengths: np.ndarray | None = None,
+    single: np.ndarray | None = None,
+) -> Binding:
+    """A Binding from array-likes, with dtypes and shapes normalised (no scaling by default)."""
+    indices = np.asarray(indices, dtype=np.int32).reshape(-1, 3)
+    n = len(indices)
+    refs = np.full((3, 2), -1, np.int32) if scale_refs is None else scale_refs
+    lengths = np.ones(3) if scale_lengths is None else scale_lengths
+    return Binding(
+        indices=indices,
+        weights=np.asarray(weights, dtype=np.float64).reshape(n, 3),
+        offsets=np.asarray(offsets, dtype=np.float64).reshape(n, 3),
+        single=np.zeros(n, bool) if single is None else np.asarray(single, bool).reshape(n),
+        scale_refs=np.asarray(refs, dtype=np.int32).reshape(3, 2),
+        scale_lengths=np.asarray(lengths, dtype=np.float64).reshape(3),
+    )
 
 
 @dataclass(frozen=True)
@@ -343,10 +414,7 @@ def _scale_lines(b: Binding) -> list[str]:
 
 def write(path: str | os.PathLike[str], proxy: ProxyFile) -> None:
     """Write a ``.mhclo`` file atomically."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(dumps(proxy), encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, dumps(proxy))
 
 
 def with_binding(proxy: ProxyFile, binding: Binding) -> ProxyFile:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from avatar.errors import FormatError
+from avatar.io import atomic
 
 AVATAR_KEY = "avatar-param"
 LIST_KEYS = ("clothes",)
@@ -114,8 +115,5 @@ def read(path: str | os.PathLike[str]) -> CharacterFile:
 
 
 def write(path: str | os.PathLike[str], character: CharacterFile) -> None:
-    """Write atomically (temporary file renamed into place)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(dumps(character), encoding="utf-8")
-    os.replace(tmp, path)
+    """Write a ``.mhm`` file atomically."""
+    atomic.write_text(path, dumps(character))

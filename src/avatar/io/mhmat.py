@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from avatar.errors import FormatError
+from avatar.io import atomic
 
 TEXTURE_KEYS = (
     "diffuseTexture",
@@ -130,10 +131,7 @@ def dumps(material: MaterialFile) -> str:
 
 def write(path: str | os.PathLike[str], material: MaterialFile) -> None:
     """Write a ``.mhmat`` file atomically."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(dumps(material), encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, dumps(material))
 
 
 def resolve_texture(value: str, folder: str | os.PathLike[str]) -> Path | None:

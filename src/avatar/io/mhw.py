@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import FormatError
+from avatar.io import atomic
 
 
 @dataclass(frozen=True)
@@ -80,4 +81,5 @@ def dumps(weights: BoneWeights) -> str:
 
 
 def write(path: str | os.PathLike[str], weights: BoneWeights) -> None:
-    Path(path).write_text(dumps(weights), encoding="utf-8")
+    """Write a weights file atomically."""
+    atomic.write_text(path, dumps(weights))

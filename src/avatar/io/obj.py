@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import FormatError
+from avatar.io import atomic
 from avatar.mesh import Mesh
 
 MAKEHUMAN = "makehuman"  # Y-up decimetres -> Avatar's Z-up metres
@@ -178,7 +179,4 @@ def _unpad(face: np.ndarray) -> list[int]:
 
 def write(path: str | os.PathLike[str], mesh: Mesh, axes: str | None = None) -> None:
     """Write a mesh as OBJ (atomically: a temporary file renamed into place)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(dumps(mesh, axes, name=path.stem), encoding="utf-8")
-    os.replace(tmp, path)
+    atomic.write_text(path, dumps(mesh, axes, name=Path(path).stem))

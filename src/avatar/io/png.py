@@ -13,14 +13,15 @@ import zlib
 
 import numpy as np
 
+from avatar.io import atomic
+
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 COLOR_TYPES = {1: 0, 2: 4, 3: 2, 4: 6}  # channels -> PNG colour type
 
 
 def write(path: str | os.PathLike[str], image: np.ndarray, level: int = 6) -> None:
-    """Write (H, W) or (H, W, C) uint8 pixels, C in 1..4, as a PNG file."""
-    with open(path, "wb") as f:
-        f.write(encode(image, level))
+    """Write (H, W) or (H, W, C) uint8 pixels, C in 1..4, as a PNG file (atomically)."""
+    atomic.write_bytes(path, encode(image, level))
 
 
 def encode(image: np.ndarray, level: int = 6) -> bytes:
