@@ -26,7 +26,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 import avatar
-from avatar.clothes import fitting, library
+from avatar.clothes import library
 from avatar.geometry import collision
 from avatar.rig import kinematics, skinning
 
@@ -48,7 +48,7 @@ def timed(fn, repeat: int) -> float:
 
 def shape_change(model) -> None:
     garments = [library.load_garment(n) for n in FOUR]
-    library.dress(avatar.Human({}, model=model), garments)  # warm-up: anchors, weights
+    library.dress(avatar.Human({}, model=model).body, garments)  # warm-up: anchors, weights
     bodies = []
     for w in np.linspace(0.1, 0.9, 20):  # a new body each call, realised outside the timing
         human = avatar.Human({"weight": w, "gender": 0.3}, model=model)
@@ -57,7 +57,7 @@ def shape_change(model) -> None:
     times = []
     for human in bodies:
         start = time.perf_counter()
-        library.dress(human, garments)
+        library.dress(human.body, garments)
         times.append(time.perf_counter() - start)
     fit = float(np.median(times))
     weights = iter(np.linspace(0.1, 0.9, 1000))  # a new body each call (no memo)
@@ -70,7 +70,7 @@ def shape_change(model) -> None:
 def posed_frames(model, frames: int) -> None:
     human = avatar.Human({"gender": 0.6}, model=model).dressed(*FOUR)
     outfit = human.outfit
-    walk = avatar.walk(human, seconds=frames / 30, fps=30)
+    walk = human.walk(seconds=frames / 30, fps=30)
     mats = kinematics.skinning_matrices(
         human.skeleton, kinematics.forward(human.skeleton, walk.rotations, walk.translations)
     )
@@ -165,7 +165,7 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: boo
                       jump_step: int, shard: tuple[int, int] = (0, 1)) -> None:  # fmt: skip
     rng = np.random.default_rng(2020)
     every = [random_body(rng) for _ in range(bodies)]  # the same bodies however sharded
-    surface = fitting.body_surface(model.base.faces)
+    surface = collision.skin_surface(model.base.faces)
     faces = model.base.faces[model.base.face_groups["body"]]
     jump = avatar.load_bvh(JUMP / "01_01_forward_jumps.bvh") if JUMP.is_dir() else None
     outfits = [("built-in", names) for names in OUTFITS] + [("MakeHuman", o) for o in mh_outfits()]
@@ -175,9 +175,9 @@ def worst_penetration(model, bodies: int, jump_every: int, step: int, exact: boo
         params = every[i]
         label = ", ".join(f"{k} {v:.2f}" for k, v in params.items())
         body = avatar.Human(params, model=model)
-        clips = {"walk": avatar.walk(body, seconds=1.2, fps=30 / step)}
+        clips = {"walk": body.walk(seconds=1.2, fps=30 / step)}
         if jump is not None and jump_every and i % jump_every == 0:
-            clips["jump"] = avatar.retarget(*jump, body, measure=False,
+            clips["jump"] = body.retarget(*jump, measure=False,
                                             frames=slice(0, 2752, 3 * jump_step))[0]  # fmt: skip
         mats = {
             name: kinematics.skinning_matrices(

@@ -30,10 +30,11 @@ def _arg(argv: list[str], name: str, default: str) -> str:
 
 def _steps(human, walk) -> dict[str, float]:
     """Seconds of the baked export's steps (to .blend) and the shape key count."""
+    from avatar import export as files
     from avatar.blender import export, scene
 
     start = time.perf_counter()
-    character = scene.character_from_human(human, animation=walk)
+    character = files.character(human, walk)
     baked = time.perf_counter()
     scene.clear_scene()
     built = scene.build_character(character)
@@ -47,9 +48,10 @@ def _steps(human, walk) -> dict[str, float]:
 
 
 def _plain_build(human, walk) -> float:
+    from avatar import export
     from avatar.blender import scene
 
-    character = scene.character_from_human(human, animation=walk, resolve_garments=False)
+    character = export.character(human, walk, resolve_garments=False)
     scene.clear_scene()
     start = time.perf_counter()
     scene.build_character(character)
@@ -61,7 +63,7 @@ def main(argv: list[str]) -> None:
 
     seconds, fps = float(_arg(argv, "--seconds", "1")), float(_arg(argv, "--fps", "30"))
     human = avatar.Human(rig="game_engine").dressed(*_arg(argv, "--wear", WEAR).split(","))
-    walk = avatar.walk(human, seconds=seconds, fps=fps)
+    walk = human.walk(seconds=seconds, fps=fps)
     print(f"{walk.frames} frames, garments {[g.name for g in human.outfit]}")  # fit once, untimed
     print("| format | plain s | baked s | plain MB | baked MB |")
     print("|---|---|---|---|---|")

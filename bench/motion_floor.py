@@ -52,10 +52,10 @@ def main(argv: list[str]) -> None:
             continue
         source, anim = bvh.load(clip)
         out, _ = retarget(source, anim, target)
-        before = floor.measure_human(human, out, most)
-        settled, shift = floor.settle_human(human, out, most)
+        before = floor.measure_body(human.body, out, most)
+        settled, shift = floor.settle_body(human.body, out, most)
         t = time.perf_counter()
-        rep = floor.measure_human(human, settled, most)
+        rep = floor.measure_body(human.body, settled, most)
         seconds = time.perf_counter() - t
         names = tuple(f"j{j}" for j in range(len(source.names)))
         anon = replace(source, names=names)

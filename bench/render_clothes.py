@@ -57,7 +57,7 @@ class Posed:
 
 
 class Dressed:
-    """A Human with garments, shaped like what ``scene.character_from_human`` reads."""
+    """A Human with garments: its parts and the outfit's."""
 
     def __init__(self, human, outfit):
         from avatar.clothes.library import parts
@@ -83,11 +83,11 @@ def main() -> None:
     chars = []
     for i, (params, names) in enumerate(BODIES):
         human = Human(params)
-        outfit = dress(human, [load_garment(n, texture_size=args.texture) for n in names])
+        outfit = dress(human.body, [load_garment(n, texture_size=args.texture) for n in names])
         shown = Dressed(human, outfit)
         if args.walk:
             shown = Posed(human, outfit, _mid_stride(human))
-        chars.append(scene.character_from_human(shown, name=f"dressed{i}"))
+        chars.append(scene.Character(f"dressed{i}", shown.parts(), shown.skeleton))
     out = Path(args.out)
     stem = "clothes_walk" if args.walk else "clothes"
     for view, direction in (("front", (0.25, -1.0, 0.12)), ("back", (-0.25, 1.0, 0.12))):
@@ -99,10 +99,9 @@ def main() -> None:
 
 def _mid_stride(human) -> np.ndarray:
     """(J, 4, 4) skinning matrices a quarter into the built-in walk: legs apart, arms swung."""
-    import avatar
     from avatar.rig import kinematics
 
-    walk = avatar.walk(human, seconds=1.0, fps=24)
+    walk = human.walk(seconds=1.0, fps=24)
     world = kinematics.forward(human.skeleton, walk.rotations[6:7], walk.translations[6:7])
     return kinematics.skinning_matrices(human.skeleton, world)[0]
 

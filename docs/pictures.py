@@ -12,7 +12,8 @@ from pathlib import Path
 
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-blender-"))
 
-from avatar.blender import render, scene  # noqa: E402
+from avatar import export  # noqa: E402
+from avatar.blender import render  # noqa: E402
 from avatar.body.model import BodyModel  # noqa: E402
 from avatar.human import Human  # noqa: E402
 
@@ -30,13 +31,13 @@ BODIES = {
 
 def bodies() -> Path:
     model = BodyModel.load()
-    chars = [scene.character_from_human(Human(p, model=model), name=n) for n, p in BODIES.items()]
+    chars = [export.character(Human(p, model=model), name=n) for n, p in BODIES.items()]
     return render.render_grid(chars, IMAGES / "bodies.png", spacing=0.9,
                               resolution=(1800, 700), samples=48)  # fmt: skip
 
 
 def _strip(human, animation, path: Path, every: int) -> Path:
-    character = scene.character_from_human(human, animation=animation)
+    character = export.character(human, animation)
     return render.render_strip(character, path, every=every, panel=(240, 400), samples=24)
 
 
@@ -47,14 +48,14 @@ def motion() -> list[Path]:
     model = BodyModel.load()
     walker = Human({"gender": 0.8, "age": 0.35}, model=model).dressed(
         "tshirt", "jeans", "shoes", "hair-short", "eyebrows")  # fmt: skip
-    out = [_strip(walker, avatar.walk(walker, seconds=1.0, fps=24), IMAGES / "walk.png", 4)]
+    out = [_strip(walker, walker.walk(seconds=1.0, fps=24), IMAGES / "walk.png", 4)]
     clip = Path(__file__).resolve().parents[2] / "shared/fixtures/bvh/cmu_motionbuilder"
     if (clip / "01_01_forward_jumps.bvh").is_file():
         jumper = Human({"gender": 0.1, "muscle": 0.7}, model=model).dressed(
             "tanktop", "leggings", "shoes", "hair-ponytail", "eyebrows")  # fmt: skip
         skeleton, anim = avatar.load_bvh(clip / "01_01_forward_jumps.bvh")
         # Retargeting onto the Human (not just its skeleton) stands the clip on its soles.
-        jump, _ = avatar.retarget(skeleton, anim, jumper, frames=slice(120, 360), fps=24)
+        jump, _ = jumper.retarget(skeleton, anim, frames=slice(120, 360), fps=24)
         out.append(_strip(jumper, jump, IMAGES / "jump.png", 8))
     return out
 

@@ -38,6 +38,6 @@ def heavy_walker(model):
     def make(seconds: float):
         human = avatar.Human({"weight": 0.8, "gender": 0.3}, rig="game_engine", model=model)
         human = human.dressed("tshirt", "jeans")
-        return human, avatar.walk(human, seconds=seconds, fps=30)
+        return human, human.walk(seconds=seconds, fps=30)
 
     return make

@@ -1,25 +1,43 @@
-"""Write a human to a file; the suffix picks the format (the one suffix registry)."""
+"""Files in and out: ``save`` writes a human, ``load`` reads a file; the suffix picks the
+format, through the one registry of formats (``WRITERS``, ``READERS``).
+
+    avatar.save(human, "out.glb", animation)       # .glb .gltf .obj .mhm .bvh .fbx .usd .blend
+    avatar.load("out.glb")                         # GltfFile: parts, skeleton, animations
+    avatar.load("me.mhm")                          # Human
+    avatar.load("clip.bvh")                        # (Skeleton, Animation)
+    avatar.load("body.obj")                        # Mesh
+
+Formats that go through Blender (FBX, USD, .blend, pictures) stage a ``Character`` record
+with the bridge (``avatar.blender``); ``character`` builds it from a human.
+"""
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
+from avatar.clothes import bake
 from avatar.errors import AvatarError
 from avatar.human import Human
+from avatar.io import bvh, gltf, mhm, obj
+from avatar.motion import poselib
+from avatar.rig.poses import rest_pose
 from avatar.rig.skeleton import Animation
 
+if TYPE_CHECKING:  # the bridge imports bpy: loaded only when a Blender format is used
+    from avatar.blender.scene import Character
 
-def _mhm(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
-    from avatar.io import mhm
+Writer = Callable[..., None]  # (human, path, animation, **options)
 
+
+def _mhm(human: Human, path: Path, animation: Animation | None, **options: Any) -> None:
     mhm.write(path, human.to_mhm(path.stem))
 
 
-def _obj(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
-    from avatar.io import obj
-
+def _obj(human: Human, path: Path, animation: Animation | None, **options: Any) -> None:
     mesh = human.mesh
     if animation is not None:  # an OBJ holds one pose: the animation's first frame
         mesh = mesh.with_vertices(
@@ -28,46 +46,55 @@ def _obj(human: Human, path: Path, animation: Animation | None, options: dict) -
     obj.write(path, mesh)
 
 
-def _gltf(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
-    from avatar.io import gltf
-
-    options = dict(options)
-    name = options.pop("animation_name", None) or "animation"
-    resolve, progress = options.pop("resolve_garments", True), options.pop("progress", False)
-    clips = {name: animation} if animation is not None else {}
-    parts, keyed = human.parts(**options), {}
-    if resolve and animation is not None and human.recipe.clothes:
-        from avatar.clothes import bake
-
-        parts, weights = bake.bake(human, animation, parts, progress)
-        keyed = {name: weights}
+def _gltf(
+    human: Human,
+    path: Path,
+    animation: Animation | None,
+    *,
+    expressions: bool = False,
+    hide_covered: bool = False,
+    animation_name: str | None = None,
+    resolve_garments: bool = True,
+    progress: bool = False,
+    **_: Any,
+) -> None:
+    clips = {animation_name or "animation": animation} if animation is not None else {}
+    parts, keyed = human.parts(expressions, hide_covered), {}
+    if resolve_garments and animation is not None and human.recipe.clothes:
+        parts, weights = bake.bake(human.body, human.outfit, animation, parts, progress)
+        keyed = {animation_name or "animation": weights}
     gltf.write(path, parts, human.skeleton, clips, morph_weights=keyed)
 
 
-def _bvh(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
-    from avatar.io import bvh
-    from avatar.motion import poselib
-    from avatar.rig.poses import rest_pose
-
+def _bvh(
+    human: Human, path: Path, animation: Animation | None, *, rest: str | None = None, **_: Any
+) -> None:
     skeleton = human.skeleton
     motion = animation if animation is not None else rest_pose(skeleton)
-    if options.get("rest"):  # e.g. a T-pose rest for pipelines that expect one
-        skeleton, motion = poselib.switch_rest(skeleton, motion, options["rest"])
+    if rest:  # e.g. a T-pose rest for pipelines that expect one
+        skeleton, motion = poselib.switch_rest(skeleton, motion, rest)
     bvh.save(path, skeleton, motion)
 
 
-def _blender(human: Human, path: Path, animation: Animation | None, options: dict) -> None:
-    from avatar.blender import export, scene
+def _blender(
+    human: Human,
+    path: Path,
+    animation: Animation | None,
+    *,
+    resolve_garments: bool = True,
+    progress: bool = False,
+    **_: Any,
+) -> None:
+    from avatar.blender import export as blender_export
+    from avatar.blender import scene
 
-    resolve, progress = options.get("resolve_garments", True), options.get("progress", False)
+    staged = character(human, animation, resolve_garments=resolve_garments, progress=progress)
     scene.clear_scene()
-    character = scene.character_from_human(human, animation=animation,
-                                           resolve_garments=resolve, progress=progress)  # fmt: skip
-    built = scene.build_character(character)
-    export.export(path, [built.root, *built.parts])
+    built = scene.build_character(staged)
+    blender_export.export(path, [built.root, *built.parts])
 
 
-WRITERS: dict[str, Callable[[Human, Path, Animation | None, dict], None]] = {
+WRITERS: dict[str, Writer] = {
     ".mhm": _mhm,
     ".obj": _obj,
     ".bvh": _bvh,
@@ -80,11 +107,20 @@ WRITERS: dict[str, Callable[[Human, Path, Animation | None, dict], None]] = {
     ".blend": _blender,
 }
 
+READERS: dict[str, Callable[[Path], Any]] = {
+    ".glb": gltf.read,
+    ".gltf": gltf.read,
+    ".obj": obj.read,
+    ".mhm": Human.from_mhm,
+    ".bvh": bvh.load,
+}
+
 
 def save(
     human: Human,
     path: str | os.PathLike[str],
     animation: Animation | None = None,
+    *,
     expressions: bool = False,
     hide_covered: bool = False,
     animation_name: str | None = None,
@@ -115,11 +151,67 @@ def save(
     if writer is None:
         raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    options = {"expressions": expressions, "hide_covered": hide_covered,
-               "animation_name": animation_name}  # fmt: skip
-    if writer in (_gltf, _blender):
-        options |= {"resolve_garments": resolve_garments, "progress": progress}
-    if rest:
-        options["rest"] = rest
-    writer(human, path, animation, options)
+    writer(human, path, animation, expressions=expressions, hide_covered=hide_covered,
+           animation_name=animation_name, rest=rest, resolve_garments=resolve_garments,
+           progress=progress)  # fmt: skip
     return path
+
+
+def load(path: str | os.PathLike[str]) -> Any:
+    """Read a file by its suffix: .glb/.gltf -> ``avatar.io.gltf.GltfFile`` (parts,
+    skeleton, animations, morph weights); .obj -> ``Mesh``; .mhm -> ``Human``; .bvh ->
+    ``(Skeleton, Animation)`` in Avatar's frame. Raises FormatError for a malformed file,
+    AvatarError for an unknown suffix or a missing file."""
+    path = Path(path)
+    reader = READERS.get(path.suffix.lower())
+    if reader is None:
+        raise AvatarError(f"{path}: unknown input format; use one of {', '.join(READERS)}")
+    if not path.is_file():
+        raise AvatarError(f"{path}: no such file")
+    return reader(path)
+
+
+def character(
+    human: Human,
+    animation: Animation | None = None,
+    *,
+    name: str = "Avatar",
+    location: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    resolve_garments: bool = True,
+    progress: bool = False,
+) -> Character:
+    """The Blender bridge's record of ``human``: its parts (body, eyes, garments), skeleton,
+    animation and recipe (stored on the character so the extension can regenerate it).
+
+    resolve_garments: when the human wears garments and an animation is given, bake each
+    frame's penetration resolve into one shape key per frame, keyed 1 at its frame only
+    (``avatar.clothes.bake`` with Blender's Armature-modifier skinning, ~0.1-0.3 s a frame),
+    so garments never show inside the body; ``progress`` shows a bar over those frames.
+    """
+    from avatar.blender.scene import Character
+
+    x, y, z = location
+    staged = Character(name, human.parts(), human.skeleton, animation, (x, y, z),
+                       human.to_recipe())  # fmt: skip
+    if resolve_garments and animation is not None and human.recipe.clothes:
+        parts, weights = bake.bake(human.body, human.outfit, animation, list(staged.parts),
+                                   progress, skin=bake.vertex_group_skin)  # fmt: skip
+        staged = replace(staged, parts=parts, morph_weights=weights)
+    return staged
+
+
+def render(
+    human: Human,
+    path: str | os.PathLike[str],
+    animation: Animation | None = None,
+    **options: Any,
+) -> Path:
+    """A PNG of ``human`` (at the middle frame of ``animation``, if any) through Blender;
+    options as ``avatar.blender.picture.render_character``. What ``create --render`` does."""
+    from avatar.blender import picture
+
+    if animation is not None:  # one picture: stage that frame only (its garments bake once)
+        middle = slice(animation.frames // 2, animation.frames // 2 + 1)
+        animation = replace(animation, rotations=animation.rotations[middle],
+                            translations=animation.translations[middle])  # fmt: skip
+    return picture.render_character(character(human, animation), path, **options)

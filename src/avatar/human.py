@@ -2,10 +2,15 @@
 
 human = Human({"gender": 1.0, "age": 0.4, "pca/belly": 1.5}, rig="game_engine")
 human.mesh, human.skeleton, human.weights, human.posed(animation)
+human.body     # the shaped body record (``avatar.body.shaped.Body``) the layers below take
+
+Names are checked here, where they enter the library: parameters (``BodyModel.resolve``),
+the rig, garments (``dressed``), each with close matches in the error.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -13,17 +18,27 @@ from typing import Any
 
 import numpy as np
 
+from avatar.body import shaped
 from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
+from avatar.body.shaped import PART_GROUPS, Body
+from avatar.clothes import library
+from avatar.clothes.outfit import Outfit
 from avatar.errors import ParameterError, unknown_name
+from avatar.io import mhm
+from avatar.looks import skin
+from avatar.material import Material
 from avatar.mesh import Mesh
+from avatar.motion import floor, poselib, procedural
+from avatar.motion.retarget import RetargetReport, retarget
+from avatar.part import MeshPart
 from avatar.rig import kinematics, skinning
 from avatar.rig.placement import RigDefinition
 from avatar.rig.skeleton import Animation, Skeleton
 from avatar.rig.skinning import SkinWeights
 
 RECIPE_VERSION = 1
-BODY_PART_GROUPS = {"body": ("body",), "eyes": ("helper-l-eye", "helper-r-eye")}
+BODY_PART_GROUPS = PART_GROUPS
 
 
 @dataclass(frozen=True)
@@ -59,6 +74,15 @@ class Recipe:
             motion=data.get("motion"),
         )
 
+    @classmethod
+    def from_mhm(cls, path: str | os.PathLike[str], rig: str | None = None) -> Recipe:
+        """The recipe of a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes);
+        ``rig`` overrides the file's skeleton."""
+        character = mhm.read(path)
+        return cls(params={**character.modifiers, **character.avatar_params},
+                   rig=rig or character.rig or "default",
+                   clothes=tuple(c.split()[0] for c in character.clothes))  # fmt: skip
+
 
 class Human:
     """A shaped, rigged human realised from a recipe. Arrays are computed lazily, once.
@@ -79,6 +103,8 @@ class Human:
         self.model = model or BodyModel.shared()
         values = self.model.resolve(params)  # validates names and ranges up front
         self.recipe = replace(recipe or Recipe(), params=values, rig=rig)
+        for garment in self.recipe.clothes:  # names, without building the garments
+            library.find_garment(garment)
 
     @classmethod
     def from_recipe(
@@ -98,9 +124,12 @@ class Human:
     @cached_property
     def vertices(self) -> np.ndarray:
         """(19158, 3) float32 all vertices incl. helpers, metres, Z-up, feet on z = 0."""
-        v = self.model.shape(self.recipe.params)
-        ground = v[self.model.base.groups["joint-ground"], 2].mean()
-        return (v - np.array([0.0, 0.0, ground], dtype=np.float32)).astype(np.float32)
+        return shaped.rest_vertices(self.model, self.recipe.params)
+
+    @cached_property
+    def body(self) -> Body:
+        """The shaped body on its rig: the record clothes, motion and Blender take."""
+        return Body(self.vertices, self.skeleton, self.weights, self.model, self.recipe.rig)
 
     def part(self, name: str) -> Mesh:
         """A renderable part ("body", "eyes") as its own Mesh (helpers excluded)."""
@@ -111,9 +140,7 @@ class Human:
 
     def part_vertices(self, name: str) -> np.ndarray:
         """Indices into ``vertices`` of a part's vertices, in the part mesh's order."""
-        base = self.model.base
-        faces = np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]])
-        return np.unique(base.faces[faces])
+        return shaped.part_vertices(self.model, name)
 
     @property
     def mesh(self) -> Mesh:
@@ -123,9 +150,7 @@ class Human:
     # ------------------------------------------------------------------ rig
     @cached_property
     def rig(self) -> RigDefinition:
-        return RigDefinition.from_json(
-            self.recipe.rig, self.model.assets.rig(self.recipe.rig), self.model.base.groups
-        )
+        return shaped.rig_definition(self.model, self.recipe.rig)
 
     @cached_property
     def skeleton(self) -> Skeleton:
@@ -143,13 +168,26 @@ class Human:
         geometry), a pose of the library (``folders``, ``$AVATAR_POSES_PATH``), or a
         ``.bvh``/MPFB ``.json`` pose file; all but "rest" stood on the floor (lowest skin
         vertex at z = 0, ``motion.floor.settle``). See ``avatar.motion.poselib``."""
-        from avatar.motion import floor, poselib
 
         def reference() -> Skeleton:  # MPFB pose files name the MakeHuman default rig's bones
-            return Human(self.params, "default", self.model).skeleton
+            if self.recipe.rig == "default":
+                return self.skeleton
+            return shaped.rig_definition(self.model, "default").skeleton(self.vertices)
 
         pose = poselib.load(name, self.skeleton, folders, reference)
-        return pose if name.lower() == "rest" else floor.settle_human(self, pose)[0]
+        return pose if name.lower() == "rest" else floor.settle_body(self.body, pose)[0]
+
+    def walk(self, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0) -> Animation:
+        """The built-in walk on this human's rig, arms hung clear of its own torso
+        (``avatar.motion.procedural.walk``)."""
+        return procedural.walk(self.skeleton, seconds, fps, cadence, body=self.body)
+
+    def retarget(
+        self, source: Skeleton, animation: Animation, **options: Any
+    ) -> tuple[Animation, RetargetReport]:
+        """A clip on ``source`` retargeted onto this human and settled on its skin (planted
+        feet on the floor); options as ``avatar.motion.retarget``."""
+        return retarget(source, animation, self.skeleton, body=self.body, **options)
 
     def posed(
         self, animation: Animation, frames: slice | None = None, method: str = "lbs"
@@ -163,15 +201,13 @@ class Human:
         return skin(self.vertices, self.weights, mats)
 
     # ------------------------------------------------------------------ export
-    def parts(self, expressions: bool = False, hide_covered: bool = False) -> list:
+    def parts(self, expressions: bool = False, hide_covered: bool = False) -> list[MeshPart]:
         """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
 
         expressions: attach the 52 ARKit face units to the body as morph targets.
         hide_covered: drop body faces that the garments cover entirely (their
             ``delete_verts``); by default the whole body is kept, e.g. for cloth simulation.
         """
-        from avatar.part import MeshPart
-
         out = []
         for name in BODY_PART_GROUPS:
             mesh, index = self.part(name), self.part_vertices(name)
@@ -182,8 +218,6 @@ class Human:
             out.append(MeshPart(name, mesh, self.material(name), (skin.indices, skin.weights),
                                 morphs))  # fmt: skip
         if self.recipe.clothes:
-            from avatar.clothes import library
-
             out += library.parts(self.outfit)
         return out
 
@@ -209,23 +243,23 @@ class Human:
         return out
 
     @cached_property
-    def outfit(self):
-        """The recipe's garments fitted on this body (``avatar.clothes.fitting.Outfit``),
+    def outfit(self) -> Outfit:
+        """The recipe's garments fitted on this body (``avatar.clothes.outfit.Outfit``),
         every vertex outside the body (``exact``: this is what exports and renders use)."""
-        from avatar.clothes import library
-
-        return library.dress(self, list(self.recipe.clothes), exact=True)
+        return library.dress(self.body, list(self.recipe.clothes), exact=True)
 
     def dressed(self, *garments: str) -> Human:
-        """A copy of this human also wearing ``garments`` (library names or .mhclo paths)."""
+        """A copy of this human also wearing ``garments`` (library names or .mhclo paths).
+
+        Raises ParameterError naming close matches for an unknown garment (checked here,
+        without building it), AvatarError for a missing ``.mhclo`` file.
+        """
         clothes = tuple(dict.fromkeys(self.recipe.clothes + tuple(str(g) for g in garments)))
         return Human(self.recipe.params, self.recipe.rig, self.model,
                      replace(self.recipe, clothes=clothes))  # fmt: skip
 
-    def material(self, part: str):
+    def material(self, part: str) -> Material:
         """The generated material of a body part (procedural skin or eye)."""
-        from avatar.looks import skin
-
         p = self.model.defaults() | self.recipe.params
         if part == "eyes":
             return skin.eye_material()
@@ -235,19 +269,14 @@ class Human:
 
     # ------------------------------------------------------------------ MakeHuman files
     @classmethod
-    def from_mhm(cls, path: str, model: BodyModel | None = None, rig: str | None = None) -> Human:
+    def from_mhm(
+        cls, path: str | os.PathLike[str], model: BodyModel | None = None, rig: str | None = None
+    ) -> Human:
         """A human from a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes)."""
-        from avatar.io import mhm
+        return cls.from_recipe(Recipe.from_mhm(path, rig), model)
 
-        character = mhm.read(path)
-        params = {**character.modifiers, **character.avatar_params}
-        recipe = Recipe(clothes=tuple(c.split()[0] for c in character.clothes))
-        return cls(params, rig or character.rig or "default", model, recipe)
-
-    def to_mhm(self, name: str = "avatar"):
+    def to_mhm(self, name: str = "avatar") -> mhm.CharacterFile:
         """This human as a MakeHuman character file record (``avatar.io.mhm``)."""
-        from avatar.io import mhm
-
         out = mhm.CharacterFile(name=name, skeleton=f"{self.recipe.rig}.mhskel")
         values = self.model.defaults() | self.recipe.params
         for key, value in values.items():
@@ -262,8 +291,6 @@ class Human:
 
 def _eye_uvs(mesh: Mesh, faces: np.ndarray, base: Mesh) -> Mesh:
     """The eyes with UVs spread over the procedural eye texture (one texture, both eyes)."""
-    from avatar.looks import skin
-
     assert mesh.uvs is not None and mesh.face_uvs is not None
     left = np.isin(faces, base.face_groups["helper-l-eye"])
     corners = mesh.uvs[mesh.face_uvs]  # (F, 4, 2) UV per face corner

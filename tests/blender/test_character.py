@@ -16,16 +16,23 @@ class FakeHuman:
     def __init__(self, recipe):
         from avatar.errors import ParameterError
 
-        self.recipe = recipe
+        self.spec = recipe
+        self.recipe = SimpleNamespace(clothes=())  # wears nothing: no garment bake
         height = recipe["params"].get("height", 0.5)
         if not 0 <= height <= 1:
             raise ParameterError("height out of range")
         self.mesh = box_mesh((0, 0, 0), (0.4, 0.3, 1.0 + height))
         self.skeleton = skeleton(np.random.default_rng(1))
         self.weights = (np.zeros((8, 1), np.int32), np.ones((8, 1)))
+        self.body = None  # the shaped-body record retargeting settles on
 
     def to_recipe(self):
-        return self.recipe
+        return self.spec
+
+    def parts(self):
+        from avatar.part import MeshPart
+
+        return [MeshPart("body", self.mesh, None, self.weights)]
 
 
 @pytest.fixture
@@ -75,10 +82,10 @@ def test_motion_is_applied_and_survives_update(empty_scene, fake_library, monkey
     character = fake_library
     calls = []
 
-    def retarget(source, clip, target, frames, fps, in_place):
+    def retarget(source, clip, target, body, frames, fps, in_place):
         calls.append((clip, frames, fps, in_place))
-        # the Motion panel retargets onto the Human (its skin settles the feet on the floor)
-        return random_animation(target.skeleton, np.random.default_rng(2), frames=6), None
+        # the Motion panel retargets onto the Human's body (its skin settles the feet)
+        return random_animation(target, np.random.default_rng(2), frames=6), None
 
     monkeypatch.setattr(avatar.motion, "load_bvh", lambda path: (None, path))
     monkeypatch.setattr(avatar.motion, "retarget", retarget)

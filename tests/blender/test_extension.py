@@ -94,6 +94,11 @@ class _Fake:
     def to_recipe(self):
         return self._recipe
 
+    def parts(self):
+        from avatar.part import MeshPart
+
+        return [MeshPart("body", self.mesh, None, self.weights)]
+
 
 def test_dress_library_lists_the_builtin_garments(installed):
     import bpy

@@ -45,13 +45,12 @@ def test_blend_export_plays_the_exact_frames_with_no_garment_inside(empty_scene,
 
     import avatar
     from avatar.blender import mesh
-    from avatar.clothes import fitting
     from avatar.geometry import collision
 
     human, walk = dressed
     avatar.save(human, tmp_path / "walk.blend", walk)  # the scene it wrote stays open
     objects = _objects()
-    triangles = fitting.body_surface(human.model.base.faces).triangles
+    triangles = collision.skin_surface(human.model.base.faces).triangles
     names = [g.name for g in human.outfit]
     for t, skinned, exact in _exact_frames(human, walk, (0, walk.frames // 2, walk.frames - 1)):
         bpy.context.scene.frame_set(1 + t)  # the action starts at frame 1

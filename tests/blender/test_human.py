@@ -36,10 +36,11 @@ def random_pose(skeleton, rng, frames=2, degrees=20.0):
 def test_blender_skinning_equals_avatar_lbs(empty_scene, human, rng):
     import bpy
 
+    from avatar import export
     from avatar.blender import mesh, scene
 
     animation = random_pose(human.skeleton, rng)
-    built = scene.build_character(scene.character_from_human(human, animation=animation))
+    built = scene.build_character(export.character(human, animation))
     bpy.context.scene.frame_set(2)
     body = next(o for o in built.parts if o.name.startswith("body"))
     expected = human.posed(animation, slice(1, 2))[0][human.part_vertices("body")]
@@ -47,9 +48,10 @@ def test_blender_skinning_equals_avatar_lbs(empty_scene, human, rng):
 
 
 def test_render_character_png(empty_scene, human, tmp_path):
+    from avatar import export
     from avatar.blender import render
 
-    path = render.render_character_png(human, tmp_path / "human.png", engine="WORKBENCH",
-                                       resolution=(128, 192))  # fmt: skip
+    path = render.render_character_png(export.character(human), tmp_path / "human.png",
+                                       engine="WORKBENCH", resolution=(128, 192))  # fmt: skip
     pixels = render.read_png(path)
     assert pixels.shape == (192, 128, 4) and pixels[..., :3].std() > 0.05

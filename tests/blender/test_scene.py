@@ -3,23 +3,20 @@
 from __future__ import annotations
 
 import json
-from types import SimpleNamespace
 
 import numpy as np
 from bridge_fixtures import box_mesh, figure, skeleton
 
 
-def test_character_from_human_like_object(empty_scene, rng):
+def test_character_from_records(empty_scene, rng):
     from avatar.blender import scene
+    from avatar.part import MeshPart
 
     skel = skeleton(rng)
-    human = SimpleNamespace(
-        mesh=box_mesh((0, 0, 0), (1, 1, 1)),
-        skeleton=skel,
-        weights=(np.zeros((8, 1), np.int32), np.ones((8, 1))),
-        to_recipe=lambda: {"macros": {"age": 0.5}},
-    )
-    built = scene.build_character(scene.character_from_human(human, name="Ann"))
+    body = MeshPart("body", box_mesh((0, 0, 0), (1, 1, 1)), None,
+                    (np.zeros((8, 1), np.int32), np.ones((8, 1))))  # fmt: skip
+    character = scene.Character("Ann", [body], skel, recipe={"macros": {"age": 0.5}})
+    built = scene.build_character(character)
     assert built.armature is built.root and built.root.name == "Ann"
     assert json.loads(built.root["avatar_recipe"]) == {"macros": {"age": 0.5}}
     body = built.parts[0]

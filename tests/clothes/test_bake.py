@@ -12,7 +12,7 @@ import pytest
 from gltf_player import Player
 
 import avatar
-from avatar.clothes import bake, fitting
+from avatar.clothes import bake
 from avatar.geometry import collision
 from avatar.io import gltf
 from avatar.rig import kinematics, skinning
@@ -50,7 +50,7 @@ def _exact_frames(human, walk):
 def test_baked_glb_plays_the_exact_frames_with_no_garment_inside(dressed, files, model):
     human, walk = dressed
     baked, plain = Player(files[0]), Player(files[1])
-    triangles = fitting.body_surface(model.base.faces).triangles
+    triangles = collision.skin_surface(model.base.faces).triangles
     plain_inside = 0
     for t, exact in _exact_frames(human, walk):
         body = baked.positions("body", t)

@@ -189,7 +189,7 @@ def test_avatar2020_garments_bind_and_follow_new_bodies(model, fixtures):
         assert np.abs(binding.fit(b, mean) - mesh.vertices).max() < 1e-5
         garments.append(Garment(name, mesh, b, z_depth=40 + len(garments)))
     human = Human({"weight": 1.0, "gender": 0.2, "age": 0.8}, model=model)
-    for fitted in dress(human, garments):
+    for fitted in dress(human.body, garments):
         count, depth = collision.penetration(human.vertices[:13380], faces, fitted.mesh.vertices)
         assert depth.max() <= 0.001, (fitted.name, count, depth.max())
 
@@ -267,7 +267,7 @@ def test_clothes_bind_cli_binds_an_obj_in_any_frame_and_refuses_a_stray_one(
     from avatar.io import obj
 
     body = Human({"weight": 0.8, "gender": 0.3}, model=model)
-    worn = library.dress(body, ["tshirt"]).garments[0].mesh
+    worn = library.dress(body.body, ["tshirt"]).garments[0].mesh
     v = worn.vertices
     exported = worn.with_vertices(np.stack([v[:, 0], v[:, 2], -v[:, 1]], axis=1))  # Y-up
     obj.write(tmp_path / "shirt.obj", exported)

@@ -120,10 +120,10 @@ def test_a_garment_fits_a_body_the_same_whatever_it_met_before(model):
     heavy = Human({"gender": 0.7, "weight": 1.0}, model=model)
     thin = Human({"gender": 0.2, "weight": 0.0, "age": 0.2}, model=model)
     fresh = replace(shorts)
-    direct = library.dress(heavy, [fresh]).garments[0].mesh.vertices
+    direct = library.dress(heavy.body, [fresh]).garments[0].mesh.vertices
     fresh = replace(shorts)
-    library.dress(thin, [fresh])
-    after = library.dress(heavy, [fresh]).garments[0].mesh.vertices
+    library.dress(thin.body, [fresh])
+    after = library.dress(heavy.body, [fresh]).garments[0].mesh.vertices
     np.testing.assert_array_equal(direct, after)
 
 
@@ -138,7 +138,6 @@ def test_exact_frames_leave_no_garment_vertex_inside_a_body_pressed_into_itself(
     skinning drives body parts into each other, yet ``Outfit.frame(exact=True)`` leaves
     every garment vertex outside (winding number, right even where the body passes into
     itself), moving only a few."""
-    from avatar.clothes import fitting
     from avatar.rig import kinematics, skinning
 
     human = Human({"gender": 0.7, "weight": 1.0, "age": 0.7}, model=model)
@@ -152,13 +151,13 @@ def test_exact_frames_leave_no_garment_vertex_inside_a_body_pressed_into_itself(
     world = kinematics.forward(human.skeleton, rotations, np.zeros((1, 3)))
     matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
     body = skinning.linear_blend(human.vertices, human.weights, matrices)[:13380]
-    triangles = fitting.body_surface(model.base.faces).triangles
+    triangles = collision.skin_surface(model.base.faces).triangles
 
     def inside(points, skin=body):
         return collision.winding_number(points, skin, triangles) > 0
 
     def pressed(skin):  # skin vertices inside the body: one part driven into another
-        return inside(skin + 5e-4 * fitting.body_surface(model.base.faces).normals(skin), skin)
+        return inside(skin + 5e-4 * collision.skin_surface(model.base.faces).normals(skin), skin)
 
     assert pressed(body).sum() > 2 * pressed(human.vertices[:13380]).sum()
     outfit = human.dressed("longsleeve", "hoodie", "trousers").outfit

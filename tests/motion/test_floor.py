@@ -34,7 +34,7 @@ def _shifted(human, heights_m) -> Animation:
 
 
 def test_rest_pose_stands_on_the_floor(human):
-    report = floor.measure_human(human, _shifted(human, np.zeros(12)))
+    report = floor.measure_body(human.body, _shifted(human, np.zeros(12)))
     assert report.frames == 12 and report.total_frames == 12
     assert np.abs(report.lowest_cm).max() < 0.2
     assert report.penetration_cm < 0.1 and report.penetrating == 0.0
@@ -43,13 +43,13 @@ def test_rest_pose_stands_on_the_floor(human):
 
 
 def test_sinking_and_hovering_are_measured(human):
-    sunk = floor.measure_human(human, _shifted(human, np.full(10, -0.03)))
+    sunk = floor.measure_body(human.body, _shifted(human, np.full(10, -0.03)))
     assert sunk.penetration_cm == pytest.approx(3.0, abs=0.2)
     assert sunk.penetrating == 1.0
-    raised = floor.measure_human(human, _shifted(human, np.full(10, 0.05)))
+    raised = floor.measure_body(human.body, _shifted(human, np.full(10, 0.05)))
     assert raised.penetration_cm == 0.0 and raised.penetrating == 0.0
     assert raised.hover_cm == pytest.approx(5.0, abs=0.2)
-    half = floor.measure_human(human, _shifted(human, np.r_[np.zeros(5), np.full(5, -0.02)]))
+    half = floor.measure_body(human.body, _shifted(human, np.r_[np.zeros(5), np.full(5, -0.02)]))
     assert half.penetrating == pytest.approx(0.5)
     assert "penetration" in half.summary() and "hover" in half.summary()
     assert set(half.as_dict()) >= {"penetration_cm", "penetrating", "hover_cm"}
@@ -58,7 +58,7 @@ def test_sinking_and_hovering_are_measured(human):
 def test_long_clips_are_subsampled(human):
     heights = np.zeros(700)
     heights[350] = -0.04  # one sunk frame in the middle: picked by the even subsample
-    report = floor.measure_human(human, _shifted(human, heights), most_frames=101)
+    report = floor.measure_body(human.body, _shifted(human, heights), most_frames=101)
     assert report.frames == 101 and report.total_frames == 700
     assert report.penetration_cm == pytest.approx(4.0, abs=0.2)
     assert report.penetrating == pytest.approx(1 / 101)
@@ -76,19 +76,19 @@ def test_settle_puts_planted_feet_on_the_floor(human):
     one sunk below it comes up; the shift is vertical only."""
     bob = 0.06 + 0.02 * np.sin(np.linspace(0, 2 * np.pi, 40))
     lifted = _shifted(human, bob)
-    settled, shift = floor.settle_human(human, lifted)
+    settled, shift = floor.settle_body(human.body, lifted)
     np.testing.assert_allclose(shift, -bob, atol=0.003)
-    report = floor.measure_human(human, settled)
+    report = floor.measure_body(human.body, settled)
     assert report.penetration_cm < 0.1 and report.hover_cm < 0.1
     # The report after a shift follows from the one before, without skinning again.
-    guess = floor.measure_human(human, lifted).shifted(shift)
+    guess = floor.measure_body(human.body, lifted).shifted(shift)
     np.testing.assert_allclose(guess.lowest_cm, report.lowest_cm, atol=1e-3)
     assert guess.hover_cm == pytest.approx(report.hover_cm, abs=1e-3)
-    _, one = floor.settle_human(human, lifted, per_frame=False)
+    _, one = floor.settle_body(human.body, lifted, per_frame=False)
     np.testing.assert_allclose(one, -np.median(bob), atol=0.003)
-    sunk, up = floor.settle_human(human, _shifted(human, [-0.05]))  # one frame: no contacts
+    sunk, up = floor.settle_body(human.body, _shifted(human, [-0.05]))  # one frame: no contacts
     assert up[0] == pytest.approx(0.05, abs=0.002)
-    assert floor.measure_human(human, sunk).penetration_cm < 0.1
+    assert floor.measure_body(human.body, sunk).penetration_cm < 0.1
     # The whole body moved straight up or down, nothing else.
     from avatar.rig.kinematics import forward
 
@@ -113,7 +113,7 @@ def test_retargeted_clips_stand_on_the_floor_before_settling(human, clip):
 
     source, clip_animation = bvh.load(clip)
     out, _ = retarget(source, clip_animation, human.skeleton, measure=False)
-    report = floor.measure_human(human, out, most_frames=600)
+    report = floor.measure_body(human.body, out, most_frames=600)
     assert report.hover_cm < 1.0 and report.penetration_cm < 1.0, report.summary()
 
 
@@ -123,12 +123,12 @@ def test_retarget_onto_a_human_settles_on_its_skin(human):
     from avatar.motion.retarget import retarget
 
     source, clip_animation = bvh.load(FIXTURES / "cmu_motionbuilder" / "02_01_walk.bvh")
-    out, report = retarget(source, clip_animation, human)
+    out, report = retarget(source, clip_animation, human.skeleton, body=human.body)
     assert report.floor is not None and "mesh on floor" in report.summary()
     assert report.floor.penetration_cm < 0.1 and report.floor.hover_cm < 0.1
     bare, plain = retarget(source, clip_animation, human.skeleton)
     assert plain.floor is None
-    settled, _ = floor.settle_human(human, bare)
+    settled, _ = floor.settle_body(human.body, bare)
     np.testing.assert_allclose(out.translations, settled.translations, atol=1e-9)
     np.testing.assert_allclose(out.rotations, bare.rotations)
 

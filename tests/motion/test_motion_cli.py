@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from avatar.cli import motion as cli
 from avatar.errors import ParameterError
 from avatar.io import bvh
-from avatar.motion import cli, timing
+from avatar.motion import timing
 
 WALK = Path(__file__).resolve().parents[2] / ".." / "shared" / "fixtures" / "bvh"
 WALK = WALK / "cmu_motionbuilder" / "02_01_walk.bvh"
@@ -31,7 +32,7 @@ def test_cli_retarget_writes_one_bvh_per_clip(tmp_path):
     report = tmp_path / "report.json"
     args = parser.parse_args([str(WALK), "--out", str(tmp_path), "--frames", "0:60",
                               "--fps", "30", "--in-place", "--report", str(report)])  # fmt: skip
-    assert cli.cli_retarget(args) == 0
+    assert cli.run_retarget(args) == 0
     skeleton, anim = bvh.load(tmp_path / WALK.name)
     assert anim.frames == 15 and anim.fps == pytest.approx(30)
     assert len(skeleton.names) == 163 and report.exists()

@@ -76,10 +76,10 @@ def test_human_pose_names(skeletons, model):
         human.pose("t-pos")
     from avatar.motion import floor
 
-    lowest = floor.measure_human(human, human.pose("a-pose")).lowest_cm
+    lowest = floor.measure_body(human.body, human.pose("a-pose")).lowest_cm
     assert abs(lowest[0]) < 0.05  # stood on the floor
     if MH_POSES.is_dir():  # a sitting pose file: feet on the floor, nothing under it
-        sit = floor.measure_human(human, human.pose(str(MH_POSES / "sit01.bvh")))
+        sit = floor.measure_body(human.body, human.pose(str(MH_POSES / "sit01.bvh")))
         assert abs(sit.lowest_cm[0]) < 0.05
 
 

@@ -12,7 +12,7 @@ from avatar.rig import kinematics
 @pytest.fixture(scope="module")
 def walking():
     human = avatar.Human({"gender": 0.8})
-    clip = avatar.walk(human, seconds=1.0, fps=30)
+    clip = human.walk(seconds=1.0, fps=30)
     world = kinematics.forward(human.skeleton, clip.rotations, clip.translations)
     return human.skeleton, np.asarray(world)
 
@@ -39,7 +39,7 @@ def test_heavier_bodies_hold_their_arms_further_out():
     from avatar.motion.procedural import _clear_hang
 
     thin, heavy = (avatar.Human({"gender": 1.0, "weight": w}) for w in (0.0, 1.0))
-    assert 15 <= _clear_hang(thin, ".L") < _clear_hang(heavy, ".L") < 45
+    assert 15 <= _clear_hang(thin.body, ".L") < _clear_hang(heavy.body, ".L") < 45
 
 
 def test_legs_alternate(walking):

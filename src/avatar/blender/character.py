@@ -7,6 +7,10 @@ character from it, in place (same name, location and collection).
 
 A recipe is what ``avatar.human.Human.to_recipe()`` returns and ``Human.from_recipe()``
 accepts: a JSON-able dict (body parameters, rig, clothes, motion).
+
+This module is the extension's composition root, as ``avatar.cli`` is the command's: it
+realises recipes into ``Human``s and hands the bridge (``scene``) their records, so it sits
+above ``avatar.export`` in the layers (see docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -18,8 +22,14 @@ from pathlib import Path
 import bpy
 from mathutils import Vector
 
+from avatar import export
+from avatar import motion as library
 from avatar.blender import mesh as mesh_bridge
 from avatar.blender import scene as stage
+from avatar.clothes import binder
+from avatar.errors import AvatarError
+from avatar.human import Human
+from avatar.rig.skeleton import Animation
 
 RECIPE_KEY = "avatar_recipe"
 MOTION_KEY = "avatar_motion"  # the Motion panel's spec: {"path", "frames", "fps", "in_place"}
@@ -33,18 +43,11 @@ def create(
     Raises AvatarError (bad parameters, missing assets, ...) before touching the scene.
     """
     human = realise(recipe)
-    character = stage.character_from_human(human, name=name, location=tuple(location))
-    if character.recipe is None:  # a Human without to_recipe(): keep what we were given
-        from dataclasses import replace
-
-        character = replace(character, recipe=dict(recipe))
-    return stage.build_character(character)
+    return stage.build_character(export.character(human, name=name, location=tuple(location)))
 
 
-def realise(recipe: Mapping[str, object]) -> object:
-    """The ``avatar.human.Human`` a recipe describes (imported here: the core, not bpy)."""
-    from avatar.human import Human
-
+def realise(recipe: Mapping[str, object]) -> Human:
+    """The ``Human`` a recipe describes."""
     return Human.from_recipe(dict(recipe))
 
 
@@ -55,8 +58,6 @@ def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.Charact
     """
     root = root_of(obj)
     if root is None:
-        from avatar.errors import AvatarError
-
         raise AvatarError(f"{obj.name!r} is not part of an Avatar character")
     motion = json.loads(root[MOTION_KEY]) if MOTION_KEY in root.keys() else None
     return _rebuild(root, recipe, motion)[0]
@@ -70,13 +71,11 @@ def apply_motion(
     motion: {"path": BVH file, "frames": [start, stop] (see ``load_motion``) or None,
     "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
     updates re-apply it. The character is rebuilt, not just given an action, because its
-    garments get one corrective shape key per frame (``scene.character_from_human``).
+    garments get one corrective shape key per frame (``avatar.export.character``).
     Returns the new objects and a one-line summary.
     """
     root = root_of(obj)
     if root is None or root.type != "ARMATURE":
-        from avatar.errors import AvatarError
-
         raise AvatarError("select a rigged Avatar character first")
     built, animation = _rebuild(root, recipe_of(root), dict(motion))
     return built, f"{built.root.name}: {animation.frames} frames at {animation.fps:g} fps"
@@ -90,12 +89,7 @@ def _rebuild(root: bpy.types.Object, recipe, motion):
     animation = load_motion(motion, human) if motion else None
     name, location = root.name, tuple(root.location)
     collection = root.users_collection[0] if root.users_collection else None
-    character = stage.character_from_human(human, name=name, location=location,
-                                           animation=animation)  # fmt: skip
-    if character.recipe is None:
-        from dataclasses import replace
-
-        character = replace(character, recipe=dict(recipe))
+    character = export.character(human, animation, name=name, location=location)
     remove(root, drop_collection=False)
     built = stage.build_character(character, collection)
     if motion:
@@ -103,21 +97,20 @@ def _rebuild(root: bpy.types.Object, recipe, motion):
     return built, animation
 
 
-def load_motion(motion: Mapping[str, object], human) -> object:
-    """The Animation of a Motion-panel spec, retargeted onto ``human`` (an
-    ``avatar.human.Human``) and settled on its skin: planted feet on the floor.
+def load_motion(motion: Mapping[str, object], human: Human) -> Animation:
+    """The Animation of a Motion-panel spec, retargeted onto ``human`` and settled on its
+    skin: planted feet on the floor.
 
     motion["frames"]: [start, stop] source frames as the CLI's ``--frames A:B`` (0-based,
     stop exclusive, None = to the end), or None for the whole clip.
     """
-    from avatar import motion as library
-
     frames = motion.get("frames")
     source_skeleton, clip = library.load_bvh(motion["path"])
     animation, _report = library.retarget(
         source_skeleton,
         clip,
-        human,
+        human.skeleton,
+        body=human.body,
         frames=slice(*frames) if frames else None,
         fps=motion.get("fps"),
         in_place=bool(motion.get("in_place")),
@@ -140,8 +133,6 @@ def bind_garment(
     origin), then bound to the body its recipe realises. Raises AvatarError (e.g. a vertex too
     far from the body) before anything is written.
     """
-    from avatar.clothes import binder
-
     root = authoring_root(garment, body)
     mesh = mesh_bridge.read_evaluated_mesh(garment, root.matrix_world.inverted())
     human = realise(recipe_of(root))
@@ -161,8 +152,6 @@ def authoring_root(
             return root
     roots = [o for o in bpy.context.scene.objects if RECIPE_KEY in o.keys()]
     if not roots:
-        from avatar.errors import AvatarError
-
         raise AvatarError("no Avatar character in the scene to bind the garment to")
     corners = [garment.matrix_world @ Vector(c) for c in garment.bound_box]
     centre = sum(corners, Vector()) / len(corners)

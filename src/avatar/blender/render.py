@@ -261,15 +261,12 @@ def write_png(path: str | os.PathLike[str], pixels: np.ndarray) -> Path:
 
 
 def render_character_png(
-    human: object,
+    character: stage.Character,
     path: str | os.PathLike[str],
     engine: str = "CYCLES",
     samples: int = 32,
     resolution: int | tuple[int, int] = (512, 768),
 ) -> Path:
-    """Render one ``avatar.human.Human``-like object (see ``scene.character_from_human``).
-
-    The CLI's ``--render out.png`` calls this.
-    """
-    stage_characters([stage.character_from_human(human)], resolution)
+    """Render one character (``avatar.export.character`` makes one of a human)."""
+    stage_characters([character], resolution)
     return render(path, engine=engine, samples=samples, resolution=resolution)

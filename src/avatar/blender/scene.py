@@ -1,8 +1,8 @@
 """Whole characters and their stage: body, garments, armature, action, camera, lights, floor.
 
 Input is plain records of arrays (a ``Character`` of ``avatar.part.MeshPart``), so the bridge
-does not depend on how the core assembles a human; ``character_from_human`` adapts an
-``avatar.human.Human``.
+does not depend on how the core assembles a human (``avatar.export.character`` makes the
+record of a ``Human``).
 """
 
 from __future__ import annotations
@@ -121,57 +121,6 @@ def _key_morphs(character: Character, objects: list[bpy.types.Object]) -> None:
         if weights is not None:
             morph_action.apply_morph_weights(obj, list(part.morphs), weights,
                                              f"{character.name} {part.name} morphs")  # fmt: skip
-
-
-def character_from_human(
-    human: object,
-    name: str = "Avatar",
-    resolve_garments: bool = True,
-    progress: bool = False,
-    **kwargs: object,
-) -> Character:
-    """Adapt an ``avatar.human.Human``-like object to a Character.
-
-    Uses ``human.parts()`` (MeshParts: body, eyes, garments) when it has it, else
-    ``human.mesh``, ``human.weights`` and ``human.material`` as one body part; plus
-    ``human.skeleton``, ``human.animation`` and ``human.to_recipe()`` when present.
-    resolve_garments: when the human wears garments and an animation is given, bake each
-    frame's penetration resolve into one shape key per frame, keyed 1 at its frame only
-    (``avatar.clothes.bake``, ~0.1-0.3 s a frame), so garments never show inside the body;
-    ``progress`` shows a bar over those frames.
-    kwargs override Character fields (e.g. ``location``, ``animation``).
-    """
-    parts = getattr(human, "parts", None)
-    if callable(parts):
-        parts = parts()
-    if parts is None:
-        parts = [MeshPart("body", human.mesh, getattr(human, "material", None),
-                          getattr(human, "weights", None))]  # fmt: skip
-    recipe = human.to_recipe() if hasattr(human, "to_recipe") else None
-    fields = dict(name=name, parts=list(parts), skeleton=getattr(human, "skeleton", None),
-                  animation=getattr(human, "animation", None), recipe=recipe)  # fmt: skip
-    fields.update(kwargs)
-    character = Character(**fields)
-    if resolve_garments and character.animation is not None and _wears_garments(human):
-        character = _resolved(human, character, progress)
-    return character
-
-
-def _wears_garments(human: object) -> bool:
-    return bool(getattr(getattr(human, "recipe", None), "clothes", None))
-
-
-def _resolved(human, character: Character, progress: bool) -> Character:
-    """The character with its garments' per-frame corrections as morphs and their weights,
-    baked for Blender's Armature modifier (every vertex group, not glTF's 8)."""
-    from dataclasses import replace
-
-    from avatar.clothes import bake
-
-    parts, weights = bake.bake(human, character.animation, list(character.parts), progress,
-                               skin=bake.vertex_group_skin)  # fmt: skip
-    return replace(character, parts=parts, morph_weights={**(character.morph_weights or {}),
-                                                          **weights})  # fmt: skip
 
 
 def new_collection(name: str, scene: bpy.types.Scene | None = None) -> bpy.types.Collection:

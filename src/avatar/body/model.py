@@ -206,12 +206,13 @@ class BodyModel:
         self.macro_sum = MacroSum(self.macro_table, self._macro_dense, self._macro_spans())
 
     @classmethod
-    def load(cls, data_dir: str | None = None) -> BodyModel:
-        """The body model over the installed MakeHuman assets (compiled on first use)."""
-        return cls(assets.load(data_dir))
+    def load(cls, data_dir: str | None = None, progress: bool = False) -> BodyModel:
+        """The body model over the installed MakeHuman assets (compiled on first use, with
+        a progress bar when ``progress``)."""
+        return cls(assets.load(data_dir, progress=progress))
 
     @classmethod
-    def shared(cls) -> BodyModel:
+    def shared(cls, progress: bool = False) -> BodyModel:
         """This thread's model over the default assets, loaded once (a load takes ~50 ms,
         a body ~1 ms): what ``Human`` uses when given no model. Per thread because a model
         memoises its last shape; a change of ``AVATAR_ASSETS`` or ``AVATAR_CACHE`` loads
@@ -220,7 +221,7 @@ class BodyModel:
         key = (os.environ.get("AVATAR_ASSETS"), os.environ.get("AVATAR_CACHE"))
         cached = getattr(_SHARED, "model", None)
         if cached is None or cached[0] != key:
-            model = cls.load()
+            model = cls.load(progress=progress)
             model.macro_sum.contract = False
             _SHARED.model = cached = (key, model)
         return cached[1]

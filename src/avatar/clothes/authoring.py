@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from avatar.body.model import BODY_VERTICES
+from avatar.body.shaped import Body
 from avatar.clothes import regions
 from avatar.clothes.binder import bind
 from avatar.clothes.binding import Binding, make_binding
@@ -25,12 +26,12 @@ from avatar.mesh import Mesh, vertex_normals
 class AuthoringBody:
     """The default human with the derived data garment builders need."""
 
-    def __init__(self, human):
-        self.human = human
-        self.vertices = np.asarray(human.vertices, dtype=np.float64)
-        self.base: Mesh = human.model.base
-        self.marks = regions.landmarks(human.skeleton)
-        self.part = regions.part_labels(human.skeleton.names, human.weights.indices[:, 0])
+    def __init__(self, body: Body):
+        self.body = body
+        self.vertices = np.asarray(body.vertices, dtype=np.float64)
+        self.base: Mesh = body.model.base
+        self.marks = regions.landmarks(body.skeleton)
+        self.part = regions.part_labels(body.skeleton.names, body.weights.indices[:, 0])
 
     @cached_property
     def skin_faces(self) -> np.ndarray:

@@ -10,7 +10,7 @@ position: skin(p + d) = skin(p) + A d with A = sum_j w_j R_j, the blend of the s
 matrices' 3x3 parts, so d = A^-1 D_t. Frame t's target is switched on (weight 1) for that
 frame only; frames that need no correction get no target.
 
-    parts, weights = bake(human, animation, human.parts())
+    parts, weights = bake(human.body, human.outfit, animation, human.parts())
     gltf.write(path, parts, human.skeleton, {"walk": animation}, morph_weights={"walk": weights})
 """
 
@@ -22,6 +22,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from avatar.body.shaped import Body
+from avatar.clothes.outfit import Outfit
 from avatar.errors import AvatarError
 from avatar.io.gltf_skin import pack_weights
 from avatar.part import MeshPart
@@ -39,7 +41,8 @@ SkinOf = Callable[[MeshPart, int], skinning.SkinWeights]  # (part, joint count) 
 
 
 def bake(
-    human,
+    body: Body,
+    outfit: Outfit,
     animation: Animation,
     parts: list[MeshPart],
     progress: bool = False,
@@ -47,9 +50,10 @@ def bake(
 ) -> tuple[list[MeshPart], dict[str, np.ndarray]]:
     """Add one morph target per corrected frame to each garment part of ``parts``.
 
-    human: a dressed ``avatar.human.Human``; parts: ``human.parts(...)`` (its last
-        ``len(human.outfit)`` parts are the garments, as ``library.parts`` makes them).
-    animation: (T frames) on ``human.skeleton``.
+    body: the shaped body; outfit: the garments fitted on it (``Human.outfit``).
+    parts: the parts to export (``Human.parts(...)``): its last ``len(outfit)`` parts are
+        the outfit's garments, as ``library.parts`` makes them.
+    animation: (T frames) on ``body.skeleton``.
     progress: show a progress bar (tqdm) over the frames.
     skin: the weights the player will skin with (default ``file_skin``, a glTF viewer's;
         ``vertex_group_skin`` for Blender's Armature modifier).
@@ -57,13 +61,12 @@ def bake(
     had; deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32
     morph weights: 1 for frame t's own target at frame t, else 0.
     """
-    outfit = human.outfit
     garments = _garment_parts(parts, outfit)
-    joints = len(human.skeleton.names)
+    joints = len(body.skeleton.names)
     skins = [(skin or file_skin)(p, joints) for p in garments]
     corrections: list[dict[int, np.ndarray]] = [{} for _ in garments]
-    for t, body, matrices in _frames(human, animation, progress):
-        resolved = outfit.frame(body, matrices, exact=True)
+    for t, posed, matrices in _frames(body, animation, progress):
+        resolved = outfit.frame(posed, matrices, exact=True)
         for i, part in enumerate(garments):
             delta = bind_correction(part.mesh.vertices, skins[i], matrices, resolved[i])
             if delta is not None:
@@ -150,7 +153,7 @@ def _garment_parts(parts: list[MeshPart], outfit) -> list[MeshPart]:
     return garments
 
 
-def _frames(human, animation: Animation, progress: bool):
+def _frames(body: Body, animation: Animation, progress: bool):
     """(t, body (V, 3), skinning matrices (J, 4, 4)) for every frame of the animation."""
     from tqdm import tqdm
 
@@ -160,12 +163,12 @@ def _frames(human, animation: Animation, progress: bool):
         for start in range(0, animation.frames, CHUNK):  # bounded memory on long clips
             rows = slice(start, start + CHUNK)
             world = kinematics.forward(
-                human.skeleton, animation.rotations[rows], animation.translations[rows]
+                body.skeleton, animation.rotations[rows], animation.translations[rows]
             )
-            for k, matrices in enumerate(kinematics.skinning_matrices(human.skeleton, world)):
+            for k, matrices in enumerate(kinematics.skinning_matrices(body.skeleton, world)):
                 yield (
                     start + k,
-                    skinning.linear_blend(human.vertices, human.weights, matrices),
+                    skinning.linear_blend(body.vertices, body.weights, matrices),
                     matrices,
                 )
                 bar.update()

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+from avatar.body.shaped import Body
 from avatar.clothes.binding import Binding, axis_scale, make_binding
 from avatar.errors import AvatarError
 from avatar.geometry import collision
@@ -141,7 +142,7 @@ def in_body_frame(
 
 def bind_obj(
     path: str | os.PathLike[str],
-    human,
+    body: Body,
     folder: str | os.PathLike[str],
     name: str | None = None,
     frame: str = "auto",
@@ -149,7 +150,7 @@ def bind_obj(
     z_depth: int = 50,
     texture: str | os.PathLike[str] | None = None,
 ) -> Path:
-    """Bind a garment OBJ modelled on ``human`` (an ``avatar.Human``) and save it in folder
+    """Bind a garment OBJ modelled on ``body`` (e.g. ``Human.body``) and save it in folder
     as ``name.mhclo`` + ``.obj`` + ``.mhmat`` (with ``texture`` copied beside them); from
     then on it fits every body. Returns the .mhclo path; on any error nothing is written."""
     import shutil
@@ -157,10 +158,10 @@ def bind_obj(
     path = Path(path)
     name = name or path.stem
     mesh = obj.read(path)
-    body = np.asarray(human.vertices, dtype=np.float64)
-    vertices, _ = in_body_frame(mesh.vertices, body, frame)
-    base = human.model.base
-    binding = bind(vertices, body, base.faces[base.face_groups["body"]])
+    authored = np.asarray(body.vertices, dtype=np.float64)
+    vertices, _ = in_body_frame(mesh.vertices, authored, frame)
+    base = body.model.base
+    binding = bind(vertices, authored, base.faces[base.face_groups["body"]])
     entries = [("name", name), ("diffuseColor", "0.8 0.8 0.8")]
     if texture is not None and not Path(texture).is_file():
         raise AvatarError(f"{texture}: texture file not found")
@@ -172,14 +173,3 @@ def bind_obj(
         shutil.copyfile(texture, Path(folder) / entries[-1][1])
     return out
 
-
-def cli_clothes_bind(args) -> int:
-    """``avatar clothes bind GARMENT.obj [--set ...] -o FOLDER``: see ``bind_obj``."""
-    from avatar.cli import parse_assignments
-    from avatar.human import Human
-
-    human = Human.from_mhm(args.mhm) if args.mhm else Human(parse_assignments(args.set or []))
-    path = bind_obj(args.garment, human, args.output, args.name, args.frame,
-                    tuple(args.tag or ()), args.z_depth, args.texture)  # fmt: skip
-    print(f"wrote {path}: wear it on any body with --wear {path}")
-    return 0

@@ -1,6 +1,6 @@
 """Put garments on a body: fit each binding, push it out of the body, stack layers, solidify.
 
-    outfit = dress(human, [load_garment("tshirt"), load_garment("jeans")])
+    outfit = dress(body, [load_garment("tshirt"), load_garment("jeans")])  # body: Human.body
     outfit.garments                # FittedGarment per garment, rest pose of this body
     outfit.frame(body, matrices)   # per posed frame: garment vertices (``outfit`` module)
 
@@ -12,11 +12,12 @@ so a jacket stays over a shirt and a shirt over its wearer, frame after frame.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from functools import cached_property, lru_cache
+from functools import cached_property
 
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
+from avatar.body.shaped import Body, default_vertices
 from avatar.clothes import weights
 from avatar.clothes.binding import Binding, fit
 from avatar.clothes.contacts import remote_contacts
@@ -101,27 +102,6 @@ class FittedGarment:
     garment: Garment
 
 
-@lru_cache(maxsize=8)
-def _surface_cached(key: bytes, faces_shape: tuple[int, int]) -> collision.BodySurface:
-    faces = np.frombuffer(key, dtype=np.int32).reshape(faces_shape)
-    return collision.body_surface(faces)
-
-
-_LAST_SURFACE: list = []  # [(faces array, surface)]: skips hashing the same faces again
-
-
-def body_surface(faces: np.ndarray) -> collision.BodySurface:
-    """The collision surface of the skin (faces of vertices < 13,380), cached by topology."""
-    if _LAST_SURFACE and _LAST_SURFACE[0][0] is faces:
-        return _LAST_SURFACE[0][1]
-    key = faces
-    faces = np.asarray(faces, dtype=np.int32)
-    skin = faces[(faces < BODY_VERTICES).all(axis=1)]
-    surface = _surface_cached(np.ascontiguousarray(skin).tobytes(), skin.shape)
-    _LAST_SURFACE[:] = [(key, surface)]  # holds the faces array: its id cannot be reused
-    return surface
-
-
 class Pose(collision.PosedBody):
     """One pose of the skin as a collider (``collision.PosedBody``) that also keeps the
     layer floors of the garments fitted on it so far."""
@@ -184,13 +164,6 @@ class Pose(collision.PosedBody):
         top = q.distance + np.float32(thickness)
         near = q.distance < FLOOR_REACH
         np.maximum.at(self.floor, q.vertex[near], top[near])
-
-
-def _body_faces(human) -> np.ndarray:
-    faces = getattr(human, "faces", None)
-    if faces is None:
-        faces = human.model.base.faces
-    return np.asarray(faces)
 
 
 def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None) -> SkinWeights:
@@ -266,19 +239,19 @@ def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo) -> Mesh:
     return mesh.with_vertices(np.concatenate([mesh.vertices[:n], outer]))
 
 
-def dress(human, garments: list[Garment], bone_names=None, exact: bool = False) -> Outfit:
+def dress(body: Body, garments: list[Garment], exact: bool = False) -> Outfit:
     """Fit garments on a body, lowest ``z_depth`` first (see module docstring).
 
-    human: anything with ``vertices`` (19158, 3), ``weights`` (SkinWeights over all
-        vertices) and ``faces`` (or ``model.base.faces``); an ``avatar.human.Human`` works.
+    body: the shaped body (``avatar.body.shaped.Body``, e.g. ``Human.body``); garments are
+        skinned to its skeleton.
     exact: then test every garment vertex by winding number and move any inside out
         (``collision.escape``; ~0.1 s an outfit): for exports and datasets. Without it,
         fitting takes a few milliseconds a garment and a vertex in a deep fold (crotch,
         armpit) of a heavy body can stay up to ~1 mm inside.
     Returns an Outfit whose ``garments`` keep the input's layer order.
     """
-    _anchor_on_default_body(human, garments)
-    outfit = _dress(human, garments, bone_names)
+    _anchor_on_default_body(body, garments)
+    outfit = _dress(body.vertices, body.faces, body.weights, body.skeleton.names, garments)
     return _escape_rest(outfit) if exact else outfit
 
 
@@ -294,16 +267,21 @@ def _escape_rest(outfit: Outfit) -> Outfit:
     return outfit
 
 
-def _dress(human, garments: list[Garment], bone_names) -> Outfit:
-    vertices = np.asarray(human.vertices, dtype=np.float32)
-    surface = body_surface(_body_faces(human))
+def _dress(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    body_weights: SkinWeights,
+    bone_names,
+    garments: list[Garment],
+) -> Outfit:
+    """The outfit of ``garments`` fitted on the body of ``vertices`` (19158, 3)."""
+    vertices = np.asarray(vertices, dtype=np.float32)
+    surface = collision.skin_surface(faces)
     pose = Pose(surface, vertices)
-    if bone_names is None and hasattr(human, "skeleton"):
-        bone_names = human.skeleton.names
     fitted, rests, ws, anchors = [], [], [], []
     for garment in sorted(garments, key=lambda g: g.z_depth):
         inner, q = fit_garment(pose, garment, vertices)
-        w = garment_weights(garment, human.weights, bone_names)
+        w = garment_weights(garment, body_weights, bone_names)
         mesh, mesh_w = (
             _with_shell(garment, inner, q, w)
             if q is not None
@@ -330,16 +308,14 @@ def _dress(human, garments: list[Garment], bone_names) -> Outfit:
     return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
 
 
-def _anchor_on_default_body(human, garments: list[Garment]) -> None:
+def _anchor_on_default_body(body: Body, garments: list[Garment]) -> None:
     """Find new garments' anchor triangles (``Garment.anchor_cache``) on the model's default
     body, each garment alone: a garment then fits a body the same way whichever bodies it
-    met before (a dataset does not depend on its order)."""
+    met before (a dataset does not depend on its order). Skin weights belong to the rig,
+    not the shape, so the default body borrows ``body``'s."""
     new = [g for g in garments if g.collide and "inner" not in g.anchor_cache]
-    model = getattr(human, "model", None)
-    if not new or model is None:
+    if not new:
         return
-    from avatar.human import Human
-
-    default = Human({}, human.recipe.rig, model)
+    default = default_vertices(body.model)
     for garment in new:
-        _dress(default, [garment], None)
+        _dress(default, body.faces, body.weights, body.skeleton.names, [garment])

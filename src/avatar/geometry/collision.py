@@ -14,10 +14,12 @@ coordinate arrays (Ericson's closest-point-on-triangle regions).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 from scipy.sparse import csr_matrix
+
+from avatar.body.model import BODY_VERTICES
 
 from .nearest import PointTree
 
@@ -112,6 +114,27 @@ def body_surface(faces: np.ndarray) -> BodySurface:
         shape=(len(count), len(faces)),
     )
     return BodySurface(faces, tris.astype(np.int32), rings, incidence)
+
+
+@lru_cache(maxsize=8)
+def _surface_cached(key: bytes, faces_shape: tuple[int, int]) -> BodySurface:
+    faces = np.frombuffer(key, dtype=np.int32).reshape(faces_shape)
+    return body_surface(faces)
+
+
+_LAST_SURFACE: list = []  # [(faces array, surface)]: skips hashing the same faces again
+
+
+def skin_surface(faces: np.ndarray) -> BodySurface:
+    """The collision surface of the skin (faces of vertices < 13,380), cached by topology."""
+    if _LAST_SURFACE and _LAST_SURFACE[0][0] is faces:
+        return _LAST_SURFACE[0][1]
+    key = faces
+    faces = np.asarray(faces, dtype=np.int32)
+    skin = faces[(faces < BODY_VERTICES).all(axis=1)]
+    surface = _surface_cached(np.ascontiguousarray(skin).tobytes(), skin.shape)
+    _LAST_SURFACE[:] = [(key, surface)]  # holds the faces array: its id cannot be reused
+    return surface
 
 
 @dataclass(frozen=True)

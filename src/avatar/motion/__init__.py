@@ -2,8 +2,8 @@
 quality metrics).
 
     skeleton, clip = load_bvh("walk.bvh")
-    animation, report = retarget(skeleton, clip, Human().skeleton)  # onto the rig
-    animation, report = retarget(skeleton, clip, Human())  # and settled on its skin
+    animation, report = retarget(skeleton, clip, human.skeleton)  # onto the rig
+    animation, report = retarget(skeleton, clip, human.skeleton, body=human.body)  # settled
     print(report.summary())
 """
 

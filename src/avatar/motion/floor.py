@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from avatar.body.shaped import Body
 from avatar.motion import bonemap, contacts
 from avatar.rig import kinematics, skinning
 from avatar.rig.skeleton import Animation, Skeleton
@@ -172,11 +173,10 @@ def _contacts(skeleton: Skeleton, world: np.ndarray, fps: float, frames: np.ndar
     return out
 
 
-def measure_human(human, animation: Animation, most_frames: int = 300) -> FloorReport:
-    """``measure`` on a Human's skin (13,380 body vertices; helpers, eyes excluded)."""
-    index = human.part_vertices("body")
-    return measure(human.skeleton, human.vertices[index], human.weights.subset(index),
-                   animation, most_frames)  # fmt: skip
+def measure_body(body: Body, animation: Animation, most_frames: int = 300) -> FloorReport:
+    """``measure`` on a shaped body's skin (13,380 vertices; helpers, eyes excluded)."""
+    return measure(body.skeleton, body.vertices[body.skin_index], body.skin_weights, animation,
+                   most_frames)  # fmt: skip
 
 
 def settle(
@@ -243,9 +243,8 @@ def raise_by(skeleton: Skeleton, animation: Animation, dz) -> Animation:
     return Animation(animation.rotations, translations, animation.fps, animation.bone_names)
 
 
-def settle_human(human, animation: Animation, most_frames: int = 300, per_frame: bool = True,
-                 report: FloorReport | None = None):  # fmt: skip
-    """``settle`` on a Human's skin; returns (animation, (T,) shifts in metres)."""
-    index = human.part_vertices("body")
-    return settle(human.skeleton, human.vertices[index], human.weights.subset(index),
-                  animation, most_frames, per_frame, report)  # fmt: skip
+def settle_body(body: Body, animation: Animation, most_frames: int = 300, per_frame: bool = True,
+                report: FloorReport | None = None):  # fmt: skip
+    """``settle`` on a shaped body's skin; returns (animation, (T,) shifts in metres)."""
+    return settle(body.skeleton, body.vertices[body.skin_index], body.skin_weights, animation,
+                  most_frames, per_frame, report)  # fmt: skip

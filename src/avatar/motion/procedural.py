@@ -4,25 +4,23 @@ A walk cycle written as joint angles about world axes (sagittal swing of hips, k
 ankles, shoulders and elbows, pelvis yaw and bob), converted into each bone's rest frame.
 The arms first come down from the rig's rest (MakeHuman's A-pose) to hang at the sides;
 the elbow's hinge turns with them, so the forearm swings forward, not across the body.
-Given a Human, each arm hangs as close to the side as its skin stays clear of the torso,
-with room for clothes on both (heavier bodies hold their arms further out, as people do).
+Given the shaped body (``Body``), each arm hangs as close to the side as its skin stays
+clear of the torso, with room for clothes on both (heavier bodies hold their arms further
+out, as people do).
 It drives MakeHuman's default-family rigs (default, default_no_toes, game_engine*) by name;
 other rigs receive it through retargeting.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
+from avatar.body.shaped import Body
 from avatar.errors import AvatarError
-from avatar.rig import quaternion
+from avatar.geometry import collision
+from avatar.rig import kinematics, quaternion, skinning
 from avatar.rig.skeleton import Animation, Skeleton
-
-if TYPE_CHECKING:
-    from avatar.human import Human
 
 X, Z = np.array([1.0, 0, 0]), np.array([0, 0, 1.0])
 
@@ -43,14 +41,19 @@ ALIASES = {"upperleg01": ("upperleg01", "thigh"), "lowerleg01": ("lowerleg01", "
 
 
 def walk(
-    target: Skeleton | Human, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0
+    skeleton: Skeleton,
+    seconds: float = 2.0,
+    fps: float = 30.0,
+    cadence: float = 1.0,
+    body: Body | None = None,
 ) -> Animation:
     """A walk of ``seconds`` along -Y at ``cadence`` strides (two steps) per second.
 
-    target: a rig, or a Human (its rig, with the arms hung clear of its own torso).
+    skeleton: the rig to drive.
+    body: the shaped body on that rig (``Human.body``): the arms then hang clear of its own
+        torso; without it they hang ARM_HANG degrees out.
     Stride length scales with leg length, so every body walks at its own natural speed.
     """
-    skeleton = target if isinstance(target, Skeleton) else target.skeleton
     t = np.arange(int(round(seconds * fps))) / fps
     phase = 2 * np.pi * cadence * t
     j = len(skeleton.names)
@@ -58,7 +61,7 @@ def walk(
     rot[..., 0] = 1.0
     trans = np.zeros((len(t), j, 3))
     for side, sign in ((".L", 0.0), (".R", np.pi)):
-        out = ARM_HANG if isinstance(target, Skeleton) else _clear_hang(target, side)
+        out = ARM_HANG if body is None else _clear_hang(body, side)
         hang = _arm_hang(skeleton, side, out)
         for key, (axis, amp, shift, offset) in WALK.items():
             bone = _find(skeleton, key, side)
@@ -97,14 +100,10 @@ def _arm_hang(skeleton: Skeleton, side: str, degrees: float) -> np.ndarray:
     return quaternion.between(rest / np.linalg.norm(rest), hang)
 
 
-def _clear_hang(human: Human, side: str) -> float:
+def _clear_hang(body: Body, side: str) -> float:
     """Degrees out from straight down (ARM_HANG..45, in 3-degree steps) at which the arm's
     skin, grown by ARM_ROOM, is first outside the body, posed by linear blend skinning."""
-    from avatar.clothes import fitting
-    from avatar.geometry import collision
-    from avatar.rig import kinematics, skinning
-
-    skeleton, weights = human.skeleton, human.weights
+    skeleton, weights = body.skeleton, body.weights
     skin = BODY_VERTICES
     arm = [i for i, n in enumerate(skeleton.names) if n.endswith(side) and n.startswith(ARM_BONES)]
     share = np.isin(weights.indices[:skin], arm) * weights.weights[:skin]
@@ -112,13 +111,13 @@ def _clear_hang(human: Human, side: str) -> float:
     shoulder = _find(skeleton, "upperarm01", side)
     if shoulder is None or len(points) == 0:
         return ARM_HANG
-    surface = fitting.body_surface(human.model.base.faces)
+    surface = collision.skin_surface(body.faces)
     rot = np.zeros((1, len(skeleton.names), 4))
     rot[..., 0] = 1.0
     for degrees in np.arange(ARM_HANG, 45.0, 3.0):
         rot[0, shoulder] = _local(skeleton, shoulder, _arm_hang(skeleton, side, degrees))
         mats = kinematics.skinning_matrices(skeleton, kinematics.forward(skeleton, rot))[0]
-        x = skinning.linear_blend(human.vertices, weights, mats)[:skin]
+        x = skinning.linear_blend(body.vertices, weights, mats)[:skin]
         grown = x[points] + ARM_ROOM * surface.normals(x)[points]
         if not np.any(collision.winding_number(grown, x, surface.triangles) > 0):
             return float(degrees)

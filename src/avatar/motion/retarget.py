@@ -13,7 +13,7 @@ Steps (``retarget``):
 7. feet: contacts detected on the source stay planted on the target (two-bone leg IK),
    and frames that would put a sole under the floor rise onto it (``contacts.lift``);
 8. world rotations -> pose-bone rotations/locations; quality metrics for the report;
-9. onto a ``Human``: the motion settled on its skin (``floor.settle``), the final polish.
+9. with the target's ``body``: the motion settled on its skin (``floor.settle``), the final polish.
 
 Per-frame arrays are quaternions and 3-vectors with the bone axis first, (J, T, 4) and
 (J, T, 3), in float32 (see docs/benchmarks.md "Motion" for why); only bones that carry
@@ -24,18 +24,15 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from avatar.body.shaped import Body
 from avatar.motion import bonemap, calibrate, contacts, floor, geometry, metrics, timing
 from avatar.motion.pairs import Pair, make_pairs, segment_rest, segments
 from avatar.rig import quaternion
 from avatar.rig.kinematics import levels, rest_quaternions, world_pose
 from avatar.rig.skeleton import Animation, Skeleton
-
-if TYPE_CHECKING:
-    from avatar.human import Human
 
 
 @dataclass(frozen=True)
@@ -96,8 +93,9 @@ class _Source:
 def retarget(
     source_skeleton: Skeleton,
     source_animation: Animation,
-    target_skeleton: Skeleton | Human,
+    target_skeleton: Skeleton,
     *,
+    body: Body | None = None,
     source_map: str | os.PathLike[str] = "auto",
     target_map: str | os.PathLike[str] = "auto",
     frames: slice | None = None,
@@ -111,9 +109,10 @@ def retarget(
 
     source_skeleton/source_animation: the clip (e.g. from ``avatar.motion.load_bvh``).
     target_skeleton: any rig (``Human(...).skeleton``), metres, Z-up, facing -Y, its rest
-        pose standing on the floor (z = 0 for Avatar rigs); or a ``Human``: its rig, and
-        the result then settled on its skin (``floor.settle_human``: planted feet touch
-        the floor, no vertex under it; ``RetargetReport.floor`` says how it meets it).
+        pose standing on the floor (z = 0 for Avatar rigs).
+    body: the shaped body on ``target_skeleton`` (``Human.body``), or None: the result is
+        then settled on its skin (``floor.settle_body``: planted feet touch the floor, no
+        vertex under it; ``RetargetReport.floor`` says how it meets it).
     source_map/target_map: convention name, bone map JSON path, or "auto".
     frames: source frames to keep (slice, applied before resampling); fps: output rate.
     in_place: remove horizontal root motion. fix_feet: keep contacts planted, soles on the
@@ -122,9 +121,6 @@ def retarget(
     measure: compute ``RetargetReport.quality`` (cheap; off for the fastest batch runs).
     Returns the target ``Animation`` (T, J_target) and a ``RetargetReport``.
     """
-    human = None
-    if not isinstance(target_skeleton, Skeleton):
-        human, target_skeleton = target_skeleton, target_skeleton.skeleton
     anim = timing.resample(timing.select(source_animation, frames), fps)
     src = _Source(source_skeleton, *world_pose(source_skeleton, anim.rotations, anim.translations,
                                                bones_first=True, dtype=_WORK_TYPE))  # fmt: skip
@@ -155,14 +151,14 @@ def retarget(
         quality = metrics.measure(pairs, src.frames_first(), target_skeleton, *framewise, tmap,
                                   feet, anim.fps)  # fmt: skip
     report = _report(pairs, smap, tmap, source_skeleton, target_skeleton, scale, out, quality)
-    return (out, report) if human is None else _settle(human, out, report)
+    return (out, report) if body is None else _settle(body, out, report)
 
 
-def _settle(human: Human, animation: Animation, report: RetargetReport):
-    """The animation settled on the human's skin (planted feet on the floor, no vertex
-    under it: ``floor.settle_human``) and the report with how it meets the floor now."""
-    ground = floor.measure_human(human, animation)
-    animation, shift = floor.settle_human(human, animation, report=ground)
+def _settle(body: Body, animation: Animation, report: RetargetReport):
+    """The animation settled on the body's skin (planted feet on the floor, no vertex
+    under it: ``floor.settle_body``) and the report with how it meets the floor now."""
+    ground = floor.measure_body(body, animation)
+    animation, shift = floor.settle_body(body, animation, report=ground)
     return animation, replace(report, floor=ground.shifted(shift))
 
 

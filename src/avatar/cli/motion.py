@@ -1,11 +1,4 @@
-"""Command-line plumbing for motion: ``avatar retarget`` (batch) and ``create --motion``.
-
-The top-level ``avatar`` command wires these in:
-
-    sub = subparsers.add_parser("retarget", help="retarget BVH clips onto an Avatar rig")
-    add_retarget_arguments(sub); sub.set_defaults(func=cli_retarget)
-    add_motion_arguments(create_parser)  # --motion --frames --fps --in-place
-"""
+"""``avatar retarget`` (batch), ``avatar poses list``, and the motion options of ``create``."""
 
 from __future__ import annotations
 
@@ -16,13 +9,32 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar.body.shaped import Body
 from avatar.errors import ParameterError
+from avatar.human import Human
 from avatar.io import bvh
-from avatar.motion import timing
+from avatar.motion import floor, poselib, timing
 from avatar.motion.retarget import RetargetReport, retarget
 from avatar.rig.skeleton import Animation, Skeleton
 
 log = logging.getLogger(__name__)
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("retarget", help="retarget BVH clips (files or folders) onto an Avatar rig",
+                       description="Retarget BVH motion capture from any common skeleton onto "
+                       "an Avatar rig; writes one BVH per clip and reports quality.")  # fmt: skip
+    add_retarget_arguments(p)
+    p.set_defaults(run=run_retarget)
+    poses = sub.add_parser("poses", help="the pose library",
+                           description="List built-in poses and the poses in user folders "
+                           "(single-frame .bvh, MPFB .json; also $AVATAR_POSES_PATH).")  # fmt: skip
+    poses_sub = poses.add_subparsers(title="commands", metavar="COMMAND")
+    p = poses_sub.add_parser("list", help="list poses (built-in and user folders)")
+    p.add_argument("--search", metavar="TEXT", help="only poses matching every word")
+    p.add_argument("--folder", action="append", default=[], metavar="DIR",
+                   help="also scan this folder (MakeHuman data/poses); repeatable")  # fmt: skip
+    p.set_defaults(run=run_poses_list)
 
 
 def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
@@ -73,18 +85,16 @@ def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
         source,
         animation,
         target,
-        source_map=getattr(args, "source_map", "auto"),
-        frames=timing.parse_frames(getattr(args, "frames", None)),
-        fps=getattr(args, "fps", None),
-        in_place=bool(getattr(args, "in_place", False)),
-        fix_feet=not getattr(args, "no_foot_fix", False),
+        source_map=args.source_map,
+        frames=timing.parse_frames(args.frames),
+        fps=args.fps,
+        in_place=args.in_place,
+        fix_feet=not args.no_foot_fix,
     )
 
 
-def cli_retarget(args: argparse.Namespace) -> int:
-    """``avatar retarget``: every clip onto one rig, a BVH per clip plus a quality line."""
-    from avatar.human import Human
-
+def run_retarget(args: argparse.Namespace) -> int:
+    """Every clip onto one rig: a BVH per clip plus a quality line (and a JSON report)."""
     human = Human(rig=args.rig)
     target = human.skeleton
     out = Path(args.out)
@@ -92,11 +102,9 @@ def cli_retarget(args: argparse.Namespace) -> int:
     table = {}
     for clip in clip_paths(args.clips):
         animation, report = motion_for(target, clip, args)
-        animation, ground = on_floor(human, animation, args)
+        animation, ground = on_floor(human.body, animation, args.keep_height)
         skeleton = target
         if args.rest:
-            from avatar.motion import poselib
-
             skeleton, animation = poselib.switch_rest(target, animation, args.rest)
         bvh.save(out / clip.name, skeleton, animation)
         print(f"{clip.name}: {report.summary()}\n{ground.summary()}")
@@ -114,14 +122,13 @@ def _row(report: RetargetReport) -> dict:
     return row
 
 
-def on_floor(human, animation: Animation, args: argparse.Namespace, most_frames: int = 3000):
-    """Unless ``--keep-height``: the motion moved up or down as a whole so planted feet
+def on_floor(body: Body, animation: Animation, keep_height: bool = False,
+             most_frames: int = 3000) -> tuple[Animation, floor.FloorReport]:  # fmt: skip
+    """Unless ``keep_height``: the motion moved up or down as a whole so planted feet
     touch the floor (``floor.settle``, logged). Returns it and its ``floor.FloorReport``."""
-    from avatar.motion import floor
-
-    report = floor.measure_human(human, animation, most_frames)
-    if not getattr(args, "keep_height", False):
-        animation, shift = floor.settle_human(human, animation, most_frames, report=report)
+    report = floor.measure_body(body, animation, most_frames)
+    if not keep_height:
+        animation, shift = floor.settle_body(body, animation, most_frames, report=report)
         report = report.shifted(shift)
         log.info("moved the motion to the floor: %+.1f cm (median; %+.1f to %+.1f cm)",
                  np.median(shift) * 100, shift.min() * 100, shift.max() * 100)  # fmt: skip
@@ -129,10 +136,8 @@ def on_floor(human, animation: Animation, args: argparse.Namespace, most_frames:
     return animation, report
 
 
-def cli_poses_list(args: argparse.Namespace) -> int:
-    """``avatar poses list``: built-in poses and pose files in user folders."""
-    from avatar.motion import poselib
-
+def run_poses_list(args: argparse.Namespace) -> int:
+    """Built-in poses and pose files in user folders."""
     words = (args.search or "").lower().split()
     for entry in poselib.list_poses(args.folder):
         text = f"{entry.name} {entry.source} {entry.description}".lower()

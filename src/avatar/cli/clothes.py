@@ -1,0 +1,59 @@
+"""``avatar clothes list|bind``: the clothes library and binding a user's garment."""
+
+from __future__ import annotations
+
+import argparse
+
+from avatar.cli.assignments import parse_assignments
+from avatar.clothes import binder, library
+from avatar.human import Human
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    clothes = sub.add_parser("clothes", help="the clothes library",
+                             description="List and search the clothes library.")  # fmt: skip
+    clothes_sub = clothes.add_subparsers(title="commands", metavar="COMMAND")
+    p = clothes_sub.add_parser("list", help="list garments (built-in and user folders)")
+    p.add_argument("--search", metavar="TEXT", help="only garments matching every word")
+    p.add_argument("--folder", action="append", metavar="DIR",
+                   help="also scan this MakeHuman/MPFB asset folder; repeatable")  # fmt: skip
+    p.set_defaults(run=run_list)
+    p = clothes_sub.add_parser(
+        "bind", help="bind a garment OBJ modelled on an Avatar body, so it fits every body",
+        description="Bind a garment mesh (OBJ) to the body it was modelled on and save it as "
+        "MakeHuman .mhclo + .obj + .mhmat; from then on it fits every body (--wear PATH).",
+    )  # fmt: skip
+    p.add_argument("garment", metavar="GARMENT.obj")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into")
+    body = p.add_mutually_exclusive_group()
+    body.add_argument("--set", action="append", metavar="NAME=VALUE",
+                      help="the body it was modelled on (as for create); repeatable")  # fmt: skip
+    body.add_argument("--mhm", metavar="FILE", help="the body it was modelled on, as a .mhm file")
+    p.add_argument("--name", help="garment name (default: the file's stem)")
+    p.add_argument("--frame", default="auto", choices=["auto", *binder.FRAMES],
+                   help="the OBJ's axes and units (default: whichever fits the body)")  # fmt: skip
+    p.add_argument("--tag", action="append", help="library tag; repeatable")
+    p.add_argument("--z-depth", type=int, default=50, help="layer: higher goes over lower")
+    p.add_argument("--texture", metavar="IMAGE", help="diffuse texture to copy beside it")
+    p.set_defaults(run=run_bind)
+
+
+def run_list(args: argparse.Namespace) -> int:
+    """Print the library: name, category, licence, tags."""
+    entries = library.list_garments(args.search, args.folder or ())
+    width = max((len(e.name) for e in entries), default=4)
+    for e in entries:
+        print(f"{e.name:<{width}}  {e.category:<9}  {e.licence:<6}  {', '.join(e.tags)}")
+    if not entries:
+        print("no garments match")
+    return 0
+
+
+def run_bind(args: argparse.Namespace) -> int:
+    """Bind the OBJ to the body it was modelled on (``binder.bind_obj``)."""
+    human = Human.from_mhm(args.mhm) if args.mhm else Human(parse_assignments(args.set or []))
+    path = binder.bind_obj(args.garment, human.body, args.output, name=args.name,
+                           frame=args.frame, tags=tuple(args.tag or ()), z_depth=args.z_depth,
+                           texture=args.texture)  # fmt: skip
+    print(f"wrote {path}: wear it on any body with --wear {path}")
+    return 0

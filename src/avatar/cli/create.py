@@ -1,0 +1,111 @@
+"""``avatar create``: make a human, shape, rig, dress, animate it, write it (and a picture).
+
+The recipe is complete before anything is built: names are checked, measurements solved on
+the model, then one ``Human`` is realised, its rig placed once, and it is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from dataclasses import replace
+from pathlib import Path
+
+from avatar import export
+from avatar.body import measures
+from avatar.body.model import BodyModel
+from avatar.cli import motion
+from avatar.cli.assignments import parse_assignments
+from avatar.clothes import library
+from avatar.human import Human, Recipe
+from avatar.motion.procedural import MOTIONS
+from avatar.rig.skeleton import Animation
+
+log = logging.getLogger("avatar")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "create",
+        help="make a human and write it to a file",
+        description="Make a human (optionally from a MakeHuman .mhm file), shape it, rig it, "
+        "dress it, animate it, and write it. The output suffix picks the format: "
+        ".glb/.gltf, .obj, .mhm, .bvh (the motion on the rig), .fbx/.usd/.blend (via Blender).",
+        epilog="examples:\n  avatar create -o human.glb\n"
+        "  avatar create --set gender=1 --set age=0.8 --set pca/belly=1.5 --rig game_engine "
+        "-o old.glb --render old.png\n  avatar create me.mhm --pose t-pose -o me.obj",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("character", nargs="?", help="a MakeHuman .mhm character file to start from")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="set a parameter (see `avatar info --params`); repeatable")  # fmt: skip
+    p.add_argument("--measure", action="append", default=[], metavar="NAME=CM",
+                   help="solve the body for a measurement in cm: height, chest, waist, hips; "
+                   "repeatable (e.g. --measure height=180 --measure waist=85)")  # fmt: skip
+    p.add_argument("--rig", help="skeleton: default, default_no_toes, game_engine, "
+                   "game_engine_with_breast, cmu_mb, mixamo (default: default)")  # fmt: skip
+    p.add_argument("--pose", metavar="NAME|FILE",
+                   help="static pose: rest, a-pose, t-pose (any rig), a pose of the library "
+                   "(see `avatar poses list`), or a .bvh (first frame) or MPFB .json pose "
+                   "file")  # fmt: skip
+    p.add_argument("--pose-folder", action="append", default=[], metavar="DIR",
+                   help="also look for poses in this folder; repeatable")  # fmt: skip
+    p.add_argument("--wear", action="append", default=[], metavar="NAME|PATH",
+                   help="garment from the library or a .mhclo file; repeatable")  # fmt: skip
+    p.add_argument("--motion", metavar="CLIP.bvh",
+                   help="BVH clip to retarget onto the human, or: walk")  # fmt: skip
+    motion.add_motion_arguments(p)
+    p.add_argument("--hide-covered", action="store_true",
+                   help="glTF: leave out skin that garments cover entirely "
+                   "(default: keep it)")  # fmt: skip
+    p.add_argument("--expressions", action="store_true",
+                   help="glTF: include the 52 ARKit face units as morph targets")  # fmt: skip
+    p.add_argument("--no-resolve-garments", dest="resolve_garments", action="store_false",
+                   help="glTF/FBX/USD/.blend: skin garments plainly instead of baking each "
+                   "frame's penetration resolve into morph targets / shape keys (faster, "
+                   "smaller; garments may clip into the body)")  # fmt: skip
+    p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
+    p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    model = BodyModel.shared(progress=True)
+    human = Human.from_recipe(_recipe(args, model), model)
+    animation, name = _animation(human, args)
+    path = export.save(human, args.output, animation, expressions=args.expressions,
+                       hide_covered=args.hide_covered, animation_name=name, rest=args.rest,
+                       resolve_garments=args.resolve_garments, progress=True)  # fmt: skip
+    log.info("wrote %s", path)
+    if args.render:
+        log.info("rendered %s", export.render(human, args.render, animation))
+    return 0
+
+
+def _recipe(args: argparse.Namespace, model: BodyModel) -> Recipe:
+    """The whole recipe from the options, every name checked, measurements solved."""
+    for name in args.wear:  # fail early, naming the unknown garment, before any fitting
+        library.find_garment(name)
+    recipe = Recipe.from_mhm(args.character) if args.character else Recipe()
+    params = model.resolve(recipe.params | parse_assignments(args.set))
+    if args.measure:
+        wanted = {k: v / 100.0 for k, v in parse_assignments(args.measure, "--measure").items()}
+        params, got = measures.fit(model, wanted, params)
+        log.info("measurements: %s", ", ".join(f"{k} {v * 100:.1f} cm" for k, v in got.items()))
+    clothes = tuple(dict.fromkeys(recipe.clothes + tuple(args.wear)))
+    return replace(recipe, params=params, rig=args.rig or recipe.rig, clothes=clothes)
+
+
+def _animation(human: Human, args: argparse.Namespace) -> tuple[Animation | None, str | None]:
+    """(the Animation or None, its name for the file: the clip's stem, the motion or pose)."""
+    if args.motion in MOTIONS:
+        clip = MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0, body=human.body)
+        return clip, args.motion
+    if args.motion:
+        animation, report = motion.motion_for(human.skeleton, args.motion, args)
+        log.info("%s", report.summary())
+        animation, _ = motion.on_floor(human.body, animation, args.keep_height)
+        return animation, Path(args.motion).stem
+    if args.pose:
+        return human.pose(args.pose, args.pose_folder), Path(args.pose).stem  # on the floor
+    return None, None
