@@ -10,7 +10,9 @@ import importlib.util
 import os
 from pathlib import Path
 
+from avatar.body.macros import is_macro_target
 from avatar.errors import AssetError
+from avatar.io import obj
 
 INSTALL_HINT = (
     "MakeHuman assets not found. Install them with\n"
@@ -203,8 +205,6 @@ def compile_assets(root: Path, folder: Path, progress: bool = False) -> None:
 
 
 def _compile_base(root: Path, arrays: dict[str, np.ndarray], meta: dict) -> None:
-    from avatar.io import obj
-
     try:
         mesh = obj.read(root / "3dobjs" / "base.obj", axes=obj.MAKEHUMAN)
     except FormatError as exc:
@@ -264,7 +264,6 @@ def _compile_targets(root: Path, arrays: dict[str, np.ndarray], meta: dict, prog
     meta["targets"] = names
     # Macro targets are dense and ~80 of them mix at once: a dense (M, V*3) matrix lets a
     # body be summed with contiguous row operations (10x faster than sparse scatter-adds).
-    from avatar.body.macros import is_macro_target
 
     macro = [k for k, n in enumerate(names) if is_macro_target(n)]
     dense = np.zeros((len(macro), 19158, 3), dtype=np.float32)

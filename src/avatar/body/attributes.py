@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from avatar.errors import FormatError
+from avatar.io.obj import to_avatar_frame
 
 if TYPE_CHECKING:
     from avatar.body.model import BodyModel
@@ -183,8 +184,6 @@ class Avatar2020Basis:
 
 
 def _read_body_txt(path: Path) -> np.ndarray:
-    from avatar.io.obj import to_avatar_frame
-
     try:
         values = np.array(path.read_text().split(), dtype=np.float64)
     except OSError as exc:

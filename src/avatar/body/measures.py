@@ -15,7 +15,9 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from avatar.body import assets
 from avatar.body.model import BODY_VERTICES
+from avatar.errors import ParameterError
 from avatar.mesh import Mesh
 
 NIPPLES = (8451, 1779)  # the default rig's breast tails: MakeHuman's nipple vertices
@@ -110,8 +112,6 @@ def _hull_perimeter(p: np.ndarray) -> float:
 def measure(vertices: np.ndarray, mesh: Mesh | None = None) -> dict[str, float]:
     """height, chest, waist and hips (metres) of a body's vertices (19158, 3)."""
     if mesh is None:
-        from avatar.body import assets
-
         mesh = assets.load().base
     tri = mesh.with_vertices(vertices).subset(mesh.face_groups["body"]).triangles()
     body = vertices[:BODY_VERTICES]
@@ -150,8 +150,6 @@ def fit(
     """
     unknown = set(targets) - set(DRIVERS)
     if unknown:
-        from avatar.errors import ParameterError
-
         raise ParameterError(f"cannot fit {', '.join(sorted(unknown))}; use {', '.join(DRIVERS)}")
     names = list(targets)
     drivers = [DRIVERS[n] for n in names]

@@ -25,6 +25,7 @@ import numpy as np
 from scipy.linalg import blas
 
 from avatar.body import assets, macros
+from avatar.body.attributes import ATTRIBUTES, basis
 from avatar.body.modifiers import Modifier, modifiers_from_target_json
 from avatar.errors import ParameterError, unknown_name
 from avatar.mesh import Mesh
@@ -269,7 +270,6 @@ class BodyModel:
             out[name] = Parameter(name, "macro", 0.0, 1.0, default, mhm)
         for m in self.modifiers:
             out[m.name] = Parameter(m.name, "modifier", m.minimum, 1.0, 0.0, m.name)
-        from avatar.body.attributes import ATTRIBUTES
 
         for attr in ATTRIBUTES:
             out[f"pca/{attr.name}"] = Parameter(f"pca/{attr.name}", "attribute", -3.0, 3.0, 0.0)
@@ -401,8 +401,6 @@ class BodyModel:
         verts = self.displacement(values)
         attrs = {k[4:]: v for k, v in values.items() if k.startswith("pca/") and v != 0.0}
         if attrs:
-            from avatar.body.attributes import basis
-
             flat, components = verts.reshape(-1), basis(self)
             for name, v in attrs.items():
                 _axpy(v, components[name].reshape(-1), flat)

@@ -14,7 +14,7 @@ import numpy as np
 
 from avatar.clothes.fitting import Garment
 from avatar.errors import FormatError
-from avatar.io import mhclo, mhmat, mhw, obj
+from avatar.io import images, mhclo, mhmat, mhw, obj
 from avatar.io.mhclo import ProxyFile
 from avatar.material import Material
 
@@ -111,8 +111,6 @@ def material_from_file(mat_path: str | os.PathLike[str]) -> Material:
 
 
 def _image(path: Path | None) -> np.ndarray | None:
-    from avatar.io import images
-
     return None if path is None else images.read(path)
 
 

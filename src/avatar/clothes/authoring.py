@@ -19,6 +19,7 @@ from avatar.body.shaped import Body
 from avatar.clothes import regions
 from avatar.clothes.binder import bind
 from avatar.clothes.binding import Binding, make_binding
+from avatar.geometry.shell import boundary_edges
 from avatar.looks.fabrics import TILE_METRES
 from avatar.mesh import Mesh, vertex_normals
 
@@ -120,8 +121,6 @@ def relax_boundary(
     surface's tangent plane at the vertex's original position (normals (N, 3)).
     Vertices where two loops touch stay put.
     """
-    from avatar.geometry.shell import boundary_edges
-
     edges, _ = boundary_edges(faces)
     count = len(points)
     seen = np.bincount(edges[:, 0], minlength=count)

@@ -28,7 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import FormatError, ParameterError, unknown_name
+from avatar.io import bvh
 from avatar.motion import bonemap, geometry
+from avatar.motion.retarget import retarget
 from avatar.rig import quaternion
 from avatar.rig.poses import from_euler_map, rebase, rest_pose
 from avatar.rig.skeleton import Animation, Skeleton
@@ -139,9 +141,6 @@ def load(
 
 
 def _from_bvh(path: Path, skeleton: Skeleton) -> Animation:
-    from avatar.io import bvh
-    from avatar.motion.retarget import retarget
-
     source, clip = bvh.load(path)
     pose, _ = retarget(source, clip, skeleton, frames=slice(0, 1), in_place=True,
                        fix_feet=False, measure=False)  # fmt: skip
@@ -161,7 +160,6 @@ def _from_mpfb(path: Path, skeleton: Skeleton, reference: Callable[[], Skeleton]
         if not known:
             raise ParameterError(f"{path}: none of its bones are in this rig")
         return from_euler_map(skeleton, rotations, data.get("bone_translations"))
-    from avatar.motion.retarget import retarget
 
     source = reference()
     pose = from_euler_map(source, rotations, data.get("bone_translations"))

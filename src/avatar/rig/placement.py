@@ -14,6 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from avatar.errors import FormatError
+from avatar.rig.quaternion import from_axis_angle, to_matrix
 from avatar.rig.skeleton import Skeleton
 
 
@@ -143,7 +144,6 @@ def rest_matrices(heads: np.ndarray, tails: np.ndarray, rolls: np.ndarray) -> np
     b[..., :, 1] = nor
     b[..., :, 2] = np.stack([-x * z / theta, -z, 1 - z * z / theta], -1)
     b[degenerate] = np.diag([-1.0, -1.0, 1.0])
-    from avatar.rig.quaternion import from_axis_angle, to_matrix
 
     roll = to_matrix(from_axis_angle(nor, np.broadcast_to(rolls, nor.shape[:-1])))
     out = np.zeros(nor.shape[:-1] + (4, 4))

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from avatar.errors import unknown_name
+
 
 @dataclass(frozen=True)
 class Skeleton:
@@ -40,8 +42,6 @@ class Skeleton:
         try:
             return self.names.index(name)
         except ValueError:
-            from avatar.errors import unknown_name
-
             raise unknown_name("bone", name, self.names) from None
 
     def local_rest(self) -> np.ndarray:
