@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
@@ -208,18 +209,21 @@ class Human:
         hide_covered: drop body faces that the garments cover entirely (their
             ``delete_verts``); by default the whole body is kept, e.g. for cloth simulation.
         """
-        out = []
-        for name in BODY_PART_GROUPS:
-            mesh, index = self.part(name), self.part_vertices(name)
-            if name == "body" and hide_covered and self.recipe.clothes:
-                mesh, index = self._uncovered_body()
-            morphs = self.expression_morphs(index) if expressions and name == "body" else {}
-            skin = self.weights.subset(index)
-            out.append(MeshPart(name, mesh, self.material(name), (skin.indices, skin.weights),
-                                morphs))  # fmt: skip
-        if self.recipe.clothes:
-            out += library.parts(self.outfit)
-        return out
+        # The procedural skin and eye textures (~0.3 s each, numpy that frees the GIL) are
+        # drawn on other cores while the garments are made and fitted.
+        with ThreadPoolExecutor(max_workers=len(BODY_PART_GROUPS)) as pool:
+            materials = {name: pool.submit(self.material, name) for name in BODY_PART_GROUPS}
+            garments = library.parts(self.outfit) if self.recipe.clothes else []
+            out = []
+            for name in BODY_PART_GROUPS:
+                mesh, index = self.part(name), self.part_vertices(name)
+                if name == "body" and hide_covered and self.recipe.clothes:
+                    mesh, index = self._uncovered_body()
+                morphs = self.expression_morphs(index) if expressions and name == "body" else {}
+                skin = self.weights.subset(index)
+                out.append(MeshPart(name, mesh, materials[name].result(),
+                                    (skin.indices, skin.weights), morphs))  # fmt: skip
+        return out + garments
 
     def _uncovered_body(self) -> tuple[Mesh, np.ndarray]:
         """The skin without faces every corner of which some garment covers."""

@@ -99,6 +99,17 @@ def test_identical_images_are_stored_once(tmp_path):
     assert len(doc.images) == 2 and len(doc.materials) == 1  # colour + normal map, one material
 
 
+def test_parallel_texture_encoding_writes_the_same_bytes(tmp_path, monkeypatch):
+    """Textures are PNG-encoded on all cores before the file is laid out; the file is the
+    same byte for byte as encoding each image when it is first used."""
+    from avatar.io import gltf_materials
+
+    parts, sk, _ = scene()
+    fast = _write(tmp_path, "fast.glb", parts, sk).read_bytes()
+    monkeypatch.setattr(gltf_materials.Materials, "encode_all", lambda self, materials: None)
+    assert _write(tmp_path, "plain.glb", parts, sk).read_bytes() == fast
+
+
 def test_more_than_four_influences_use_joints_1(tmp_path):
     mesh = box([-0.1, -0.1, 0], [0.1, 0.1, 2])
     sk = chain(10)

@@ -93,6 +93,7 @@ def write(
         for name, animation in named.items():
             gltf_skin.add_animation(gltf, packer, skeleton, animation, name)
     materials = gltf_materials.Materials(gltf, packer)
+    materials.encode_all(part.material for part in parts)
     nodes = {}
     for part in parts:
         nodes[part.name] = _add_part(gltf, packer, part, materials, skin_index, vertex_ids)

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import base64
 import hashlib
+import os
+from collections.abc import Iterable
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pygltflib as g
@@ -26,6 +29,22 @@ class Materials:
         self.gltf, self.packer = gltf, packer
         self.by_id: dict[int, int] = {}
         self.images: dict[bytes, int] = {}
+        self.encoded: dict[bytes, bytes] = {}  # image key -> PNG bytes (``encode_all``)
+
+    def encode_all(self, materials: Iterable[Material | None]) -> None:
+        """Encode every distinct texture of ``materials`` as PNG at once, on all cores
+        (zlib releases the GIL; compression is most of a textured export's time). The
+        file is the same byte for byte: images are still added in first-use order."""
+        todo: dict[bytes, np.ndarray] = {}
+        for m in materials:
+            for image in _images(m):
+                key = _key(image)
+                if key not in self.encoded:
+                    todo.setdefault(key, image)
+        if not todo:
+            return
+        with ThreadPoolExecutor(max_workers=min(len(todo), os.cpu_count() or 1)) as pool:
+            self.encoded.update(zip(todo, pool.map(png.encode, todo.values()), strict=True))
 
     def index(self, material: Material) -> int:
         if id(material) not in self.by_id:
@@ -71,14 +90,32 @@ class Materials:
 
     def _texture(self, image: np.ndarray, name: str) -> int:
         """A texture for the image (one PNG per distinct image); return the texture index."""
-        key = hashlib.blake2b(image.tobytes() + repr(image.shape).encode(), digest_size=16).digest()
+        key = _key(image)
         if key not in self.images:
             if not self.gltf.samplers:
                 self.gltf.samplers.append(g.Sampler(magFilter=9729, minFilter=9987))
-            source = self.packer.image(png.encode(image), name)
+            data = self.encoded.pop(key, None) or png.encode(image)
+            source = self.packer.image(data, name)
             self.gltf.textures.append(g.Texture(sampler=0, source=source, name=name))
             self.images[key] = len(self.gltf.textures) - 1
         return self.images[key]
+
+
+def _key(image: np.ndarray) -> bytes:
+    """A content key of an image (pixels and shape)."""
+    return hashlib.blake2b(image.tobytes() + repr(image.shape).encode(), digest_size=16).digest()
+
+
+def _images(m: Material | None) -> list[np.ndarray]:
+    """The images ``Materials`` will embed for a material, as it embeds them."""
+    if m is None:
+        return []
+    out = [m.base_color_texture] if m.base_color_texture is not None else []
+    if m.roughness_texture is not None:
+        out.append(_pack_roughness(m.roughness_texture))
+    if m.normal_texture is not None:
+        out.append(m.normal_texture)
+    return out
 
 
 def _pack_roughness(rough: np.ndarray) -> np.ndarray:
