@@ -135,3 +135,18 @@ def test_load_refuses_unknown_suffixes_and_missing_files(tmp_path):
         avatar.load(tmp_path / "x.xyz")
     with pytest.raises(AvatarError, match="no such file"):
         avatar.load(tmp_path / "missing.glb")
+
+
+def test_the_extension_path_needs_no_pygltflib_nor_tqdm(model):
+    """Debian's Blender (the UI test, legacy add-on installs) has numpy, SciPy and Pillow
+    only: making, dressing and staging a character must not import pygltflib or tqdm."""
+    code = (
+        "import sys; sys.modules['pygltflib'] = None; sys.modules['tqdm'] = None\n"
+        "import avatar, avatar.export\n"
+        "human = avatar.Human().dressed('tshirt')\n"
+        "parts = human.parts()\n"
+        "print(len(parts))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                         text=True).stdout  # fmt: skip
+    assert out.strip() == "3"

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from avatar.clothes import bake
 from avatar.errors import AvatarError
 from avatar.human import Human
-from avatar.io import bvh, gltf, mhm, obj
+from avatar.io import bvh, mhm, obj
 from avatar.motion import poselib
 from avatar.rig.poses import rest_pose
 from avatar.rig.skeleton import Animation
@@ -58,6 +58,8 @@ def _gltf(
     progress: bool = False,
     **_: Any,
 ) -> None:
+    from avatar.io import gltf  # pygltflib: not in every Blender's Python, only glTF needs it
+
     clips = {animation_name or "animation": animation} if animation is not None else {}
     parts, keyed = human.parts(expressions, hide_covered), {}
     if resolve_garments and animation is not None and human.recipe.clothes:
@@ -107,9 +109,15 @@ WRITERS: dict[str, Writer] = {
     ".blend": _blender,
 }
 
+def _read_gltf(path: Path) -> Any:
+    from avatar.io import gltf  # see _gltf
+
+    return gltf.read(path)
+
+
 READERS: dict[str, Callable[[Path], Any]] = {
-    ".glb": gltf.read,
-    ".gltf": gltf.read,
+    ".glb": _read_gltf,
+    ".gltf": _read_gltf,
     ".obj": obj.read,
     ".mhm": Human.from_mhm,
     ".bvh": bvh.load,

@@ -15,7 +15,7 @@ from gltf_fixtures import box, chain, many_influences, scene, skeleton
 from avatar.errors import FormatError, ParameterError
 from avatar.io import gltf
 from avatar.io import gltf_accessors as acc
-from avatar.io.gltf_skin import pack_weights
+from avatar.io.gltf_weights import pack_weights
 from avatar.material import Material
 from avatar.part import MeshPart
 from avatar.rig import kinematics, quaternion

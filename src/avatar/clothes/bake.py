@@ -4,7 +4,7 @@ A glTF viewer skins a garment with plain linear blend skinning (LBS), which driv
 the body where the body bends; ``Outfit.frame(..., exact=True)`` pushes it back out. For
 every frame t this module takes the resolved vertices V_t and what the viewer will compute,
 L_t = LBS of the exported part mesh with the weights exactly as the file stores them
-(``gltf_skin.pack_weights``: at most 8 influences, renormalised), and turns the posed
+(``gltf_weights.pack_weights``: at most 8 influences, renormalised), and turns the posed
 correction D_t = V_t - L_t into a bind-space morph delta. LBS is linear in the rest
 position: skin(p + d) = skin(p) + A d with A = sum_j w_j R_j, the blend of the skinning
 matrices' 3x3 parts, so d = A^-1 D_t. Frame t's target is switched on (weight 1) for that
@@ -25,7 +25,7 @@ import numpy as np
 from avatar.body.shaped import Body
 from avatar.clothes.outfit import Outfit
 from avatar.errors import AvatarError
-from avatar.io.gltf_skin import pack_weights
+from avatar.io.gltf_weights import pack_weights
 from avatar.part import MeshPart
 from avatar.rig import kinematics, skinning
 from avatar.rig.skeleton import Animation

@@ -30,7 +30,7 @@ import numpy as np
 import pygltflib as g
 
 from avatar.errors import FormatError
-from avatar.io import atomic, gltf_materials, gltf_morphs, gltf_skin
+from avatar.io import atomic, gltf_materials, gltf_morphs, gltf_skin, gltf_weights
 from avatar.io import gltf_accessors as acc
 from avatar.mesh import Mesh, vertex_normals
 from avatar.part import MeshPart
@@ -200,7 +200,7 @@ def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: b
 
 def _add_skin_attributes(attributes, packer, skin, source, joint_count: int) -> None:
     """JOINTS_0/WEIGHTS_0 (and _1 for more than four influences) for the glTF vertices."""
-    joints, weights = gltf_skin.pack_weights(skin[0][source], skin[1][source], joint_count)
+    joints, weights = gltf_weights.pack_weights(skin[0][source], skin[1][source], joint_count)
     for set_index in range(joints.shape[1] // 4):
         cols = slice(4 * set_index, 4 * set_index + 4)
         setattr(
