@@ -30,7 +30,7 @@ import pytest
 # The layer table, lowest first: rank -> components. A module may import its own rank and below.
 # The single source of the layering: place every new top-level package or module of avatar here.
 LAYERS: dict[int, tuple[str, ...]] = {
-    0: ("errors", "mesh", "material", "part"),  # base records and errors
+    0: ("errors", "mesh", "material", "part", "camera"),  # base records, errors, camera maths
     1: ("rig",),
     2: ("io",),  # file formats only
     3: ("body",),
