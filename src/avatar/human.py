@@ -10,11 +10,13 @@ the rig, garments (``dressed``), each with close matches in the error.
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -24,6 +26,7 @@ from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
 from avatar.clothes import library
+from avatar.clothes.asset import material_from_file
 from avatar.clothes.outfit import Outfit
 from avatar.errors import ParameterError, unknown_name
 from avatar.io import mhm
@@ -38,19 +41,58 @@ from avatar.rig.placement import RigDefinition
 from avatar.rig.skeleton import Animation, Skeleton
 from avatar.rig.skinning import SkinWeights
 
-RECIPE_VERSION = 1
+log = logging.getLogger(__name__)
+
+RECIPE_VERSION = 2  # 2: MakeHuman looks (eyes, skin, expression, ...), hide_covered, folders
 BODY_PART_GROUPS = PART_GROUPS
+# MakeHuman's eye materials (eyes/materials/<stem>.mhmat) -> Avatar's iris colours.
+EYE_COLOURS = {"brown": "brown", "brownlight": "hazel", "lightbrown": "hazel", "hazel": "hazel",
+               "darkbrown": "dark_brown", "dark_brown": "dark_brown", "green": "green",
+               "bluegreen": "green", "blue": "blue", "lightblue": "blue", "darkblue": "blue",
+               "deepblue": "blue", "ice": "grey", "grey": "grey", "gray": "grey"}  # fmt: skip
+DEFAULT_EYE_MATERIAL = "eyes/materials/brown.mhmat"
+DEFAULT_SKIN_MATERIAL = "skins/default.mhmat"  # MakeHuman's untextured default skin
+WEARABLE = ("clothes", "hair", "eyebrows", "eyelashes")  # .mhm proxies Avatar dresses in
+_FIELDS = ("version", "params", "rig", "pose", "clothes", "motion", "name", "eye_material",
+           "skin_material", "expression", "hide_covered", "subdivide", "folders",
+           "mhm")  # fmt: skip
 
 
 @dataclass(frozen=True)
 class Recipe:
-    """Everything that defines a character; plain data, JSON-serialisable."""
+    """Everything that defines a character; plain data, JSON-serialisable (``to_dict``).
+
+    params: body parameters; rig: the skeleton; pose: a pose name or file (MakeHuman's
+        ``pose`` line), the character's static pose; clothes: garments, hair, eyebrows and
+        eyelashes worn (built-in names or ``.mhclo`` paths); motion: a motion name or file.
+    name: the character's name. eye_material: a MakeHuman eye material file
+        (``eyes/materials/blue.mhmat``), whose stem picks the iris colour (``EYE_COLOURS``);
+        None: brown. skin_material: a MakeHuman skin ``.mhmat`` (used when it is found and
+        has a texture; else Avatar's procedural skin). expression: a MakeHuman expression
+        (``.mhpose``), kept for the file (Avatar's faces are the ``expression/*`` params).
+    hide_covered: leave out body faces the garments cover (their ``delete_verts``), as
+        MakeHuman's ``clothesHideFaces``: None (default) for MakeHuman garments only (built-ins
+        keep the body, e.g. for cloth simulation), True for every garment, False for none.
+    subdivide: MakeHuman's smoothing flag (kept for the file).
+    folders: asset folders (MakeHuman/MPFB data, user garments) searched besides
+        ``$AVATAR_CLOTHES_PATH`` for the garments and materials named here.
+    mhm: other ``.mhm`` statements kept verbatim as (key, rest of line): camera, tags, the
+        eyes proxy, proxies and materials Avatar does not use, assets not found.
+    """
 
     params: dict[str, float] = field(default_factory=dict)
     rig: str = "default"
     pose: str | None = None
     clothes: tuple[str, ...] = ()
     motion: str | None = None
+    name: str = ""
+    eye_material: str | None = None
+    skin_material: str | None = None
+    expression: str | None = None
+    hide_covered: bool | None = None
+    subdivide: bool = False
+    folders: tuple[str, ...] = ()
+    mhm: tuple[tuple[str, str], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -60,29 +102,101 @@ class Recipe:
             "pose": self.pose,
             "clothes": list(self.clothes),
             "motion": self.motion,
+            "name": self.name,
+            "eye_material": self.eye_material,
+            "skin_material": self.skin_material,
+            "expression": self.expression,
+            "hide_covered": self.hide_covered,
+            "subdivide": self.subdivide,
+            "folders": list(self.folders),
+            "mhm": [list(kv) for kv in self.mhm],
         }
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Recipe:
-        unknown = set(data) - {"version", "params", "rig", "pose", "clothes", "motion"}
+        """A recipe from ``to_dict``'s output (any version up to ``RECIPE_VERSION``)."""
+        unknown = set(data) - set(_FIELDS)
         if unknown:
             raise ParameterError(f"unknown recipe fields: {', '.join(sorted(unknown))}")
+        version = data.get("version", 1)
+        if not isinstance(version, int) or not 1 <= version <= RECIPE_VERSION:
+            raise ParameterError(f"recipe version {version!r} is not one this Avatar reads "
+                                 f"(1..{RECIPE_VERSION})")  # fmt: skip
+        hide = data.get("hide_covered")
         return cls(
             params={str(k): float(v) for k, v in (data.get("params") or {}).items()},
             rig=str(data.get("rig", "default")),
-            pose=data.get("pose"),
-            clothes=tuple(data.get("clothes") or ()),
-            motion=data.get("motion"),
+            pose=_text(data.get("pose")),
+            clothes=tuple(str(c) for c in data.get("clothes") or ()),
+            motion=_text(data.get("motion")),
+            name=str(data.get("name") or ""),
+            eye_material=_text(data.get("eye_material")),
+            skin_material=_text(data.get("skin_material")),
+            expression=_text(data.get("expression")),
+            hide_covered=None if hide is None else bool(hide),
+            subdivide=bool(data.get("subdivide", False)),
+            folders=tuple(str(f) for f in data.get("folders") or ()),
+            mhm=tuple(_statement(kv) for kv in data.get("mhm") or ()),
         )
 
     @classmethod
-    def from_mhm(cls, path: str | os.PathLike[str], rig: str | None = None) -> Recipe:
-        """The recipe of a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes);
-        ``rig`` overrides the file's skeleton."""
+    def from_mhm(
+        cls,
+        path: str | os.PathLike[str],
+        rig: str | None = None,
+        folders: Sequence[str | os.PathLike[str]] = (),
+    ) -> Recipe:
+        """The recipe of a MakeHuman ``.mhm`` character file: modifiers, skeleton (``rig``
+        overrides it), clothes, hair, eyebrows and eyelashes (found by uuid, else by name,
+        in the library, ``folders`` and ``$AVATAR_CLOTHES_PATH``), eyes and skin materials,
+        pose, expression, clothesHideFaces, subdivide; every other line is kept for re-saving.
+        An asset that is not found is logged and kept in the file, not worn (as MakeHuman does).
+        """
         character = mhm.read(path)
+        names = tuple(str(f) for f in folders)
+        clothes, kept = [], []
+        for ref in character.proxies:
+            if ref.kind in WEARABLE:
+                found = library.find_reference(ref.name, ref.uuid, names)
+                if found is not None:
+                    clothes.append(found)
+                    continue
+                log.warning("%s: %s %r (uuid %s) is not in the clothes library or its "
+                            "folders: kept in the file, not worn", path, ref.kind, ref.name,
+                            ref.uuid or "-")  # fmt: skip
+            kept.append((ref.kind, ref.line()[len(ref.kind) + 1 :]))
+        eyes = character.proxy("eyes")
+        eye_material = None
+        for m in character.materials:
+            of_eyes = eyes is not None and (m.uuid == eyes.uuid or m.proxy == eyes.name)
+            if of_eyes and eye_material is None:
+                eye_material = m.file
+            else:
+                kept.append(("material", f"{m.proxy} {m.uuid} {m.file}"))
+        text = dict(character.text)
+        kept += [(k, text.pop(k)) for k in ("uuid", "tags", "camera") if k in text]
+        if "expression" in text:
+            log.info("%s: MakeHuman expression %s kept for the file (not applied; Avatar's "
+                     "faces are the expression/* parameters)", path,
+                     text["expression"])  # fmt: skip
+        hide = character.flags.get("clothesHideFaces")
         return cls(params={**character.modifiers, **character.avatar_params},
-                   rig=rig or character.rig or "default",
-                   clothes=tuple(c.split()[0] for c in character.clothes))  # fmt: skip
+                   rig=rig or character.rig or "default", pose=text.get("pose"),
+                   clothes=tuple(dict.fromkeys(clothes)), name=text.get("name", ""),
+                   eye_material=eye_material, skin_material=text.get("skinMaterial"),
+                   expression=text.get("expression"), hide_covered=hide,
+                   subdivide=character.flags.get("subdivide", False), folders=names,
+                   mhm=tuple(kept + list(character.other)))  # fmt: skip
+
+
+def _text(value: Any) -> str | None:
+    return None if value is None else str(value)
+
+
+def _statement(kv: Any) -> tuple[str, str]:
+    if not isinstance(kv, (list, tuple)) or len(kv) != 2:
+        raise ParameterError(f"recipe 'mhm' entries are [key, text] pairs, got {kv!r}")
+    return str(kv[0]), str(kv[1])
 
 
 class Human:
@@ -105,7 +219,7 @@ class Human:
         values = self.model.resolve(params)  # validates names and ranges up front
         self.recipe = replace(recipe or Recipe(), params=values, rig=rig)
         for garment in self.recipe.clothes:  # names, without building the garments
-            library.find_garment(garment)
+            library.find_garment(garment, self.recipe.folders)
 
     @classmethod
     def from_recipe(
@@ -202,35 +316,49 @@ class Human:
         return skin(self.vertices, self.weights, mats)
 
     # ------------------------------------------------------------------ export
-    def parts(self, expressions: bool = False, hide_covered: bool = False) -> list[MeshPart]:
+    def parts(self, expressions: bool = False, hide_covered: bool | None = None) -> list[MeshPart]:
         """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
 
         expressions: attach the 52 ARKit face units to the body as morph targets.
-        hide_covered: drop body faces that the garments cover entirely (their
-            ``delete_verts``); by default the whole body is kept, e.g. for cloth simulation.
+        hide_covered: drop body faces that garments cover entirely (their ``delete_verts``,
+            MakeHuman's ``clothesHideFaces``): True for every garment, False for none (the
+            whole body, e.g. for cloth simulation); None: the recipe's ``hide_covered``,
+            by default MakeHuman garments only (``hidden_by``).
         """
         # The procedural skin and eye textures (~0.3 s each, numpy that frees the GIL) are
         # drawn on other cores while the garments are made and fitted.
         with ThreadPoolExecutor(max_workers=len(BODY_PART_GROUPS)) as pool:
             materials = {name: pool.submit(self.material, name) for name in BODY_PART_GROUPS}
             garments = library.parts(self.outfit) if self.recipe.clothes else []
+            hiding = self.hidden_by(hide_covered) if self.recipe.clothes else []
             out = []
             for name in BODY_PART_GROUPS:
                 mesh, index = self.part(name), self.part_vertices(name)
-                if name == "body" and hide_covered and self.recipe.clothes:
-                    mesh, index = self._uncovered_body()
+                if name == "body" and hiding:
+                    mesh, index = self._uncovered_body(hiding)
                 morphs = self.expression_morphs(index) if expressions and name == "body" else {}
                 skin = self.weights.subset(index)
                 out.append(MeshPart(name, mesh, materials[name].result(),
                                     (skin.indices, skin.weights), morphs))  # fmt: skip
         return out + garments
 
-    def _uncovered_body(self) -> tuple[Mesh, np.ndarray]:
-        """The skin without faces every corner of which some garment covers."""
+    def hidden_by(self, hide_covered: bool | None = None) -> list[str]:
+        """Names of the garments whose covered body faces are left out of the body part:
+        every garment (True), none (False), or by default (None, then the recipe's
+        ``hide_covered``) those that are MakeHuman assets (``.mhclo`` files), as MakeHuman
+        shows them; built-ins keep the body under them unless asked."""
+        hide = self.recipe.hide_covered if hide_covered is None else hide_covered
+        if hide is False or not self.recipe.clothes:
+            return []
+        return [g.name for g in self.outfit.garments if hide or g.garment.source != "builtin"]
+
+    def _uncovered_body(self, garments: Sequence[str]) -> tuple[Mesh, np.ndarray]:
+        """The skin without faces every corner of which one of ``garments`` covers."""
         base = self.model.base
         covered = np.zeros(len(self.vertices), dtype=bool)
         for g in self.outfit.garments:
-            covered[g.delete_verts] = True
+            if g.name in garments:
+                covered[g.delete_verts] = True
         faces = base.face_groups["body"]
         keep = np.sort(faces[~covered[base.faces[faces]].all(axis=1)])
         return base.with_vertices(self.vertices).subset(keep), np.unique(base.faces[keep])
@@ -250,7 +378,8 @@ class Human:
     def outfit(self) -> Outfit:
         """The recipe's garments fitted on this body (``avatar.clothes.outfit.Outfit``),
         every vertex outside the body (``exact``: this is what exports and renders use)."""
-        return library.dress(self.body, list(self.recipe.clothes), exact=True)
+        return library.dress(self.body, list(self.recipe.clothes), exact=True,
+                             folders=self.recipe.folders)  # fmt: skip
 
     def dressed(self, *garments: str) -> Human:
         """A copy of this human also wearing ``garments`` (library names or .mhclo paths).
@@ -263,33 +392,102 @@ class Human:
                      replace(self.recipe, clothes=clothes))  # fmt: skip
 
     def material(self, part: str) -> Material:
-        """The generated material of a body part (procedural skin or eye)."""
-        p = self.model.defaults() | self.recipe.params
+        """The material of a body part: the eyes' iris from the recipe's eye material, the
+        skin from its MakeHuman skin ``.mhmat`` when one is found with a texture, else
+        Avatar's procedural skin for this body's ethnicity and age."""
         if part == "eyes":
-            return skin.eye_material()
+            return skin.eye_material(self.eye_colour)
+        found = self._skin_file()
+        if found is not None:
+            loaded = material_from_file(found)
+            if loaded.base_color_texture is not None:
+                return loaded
+            log.info("%s has no texture: Avatar's procedural skin is used", found)
+        p = self.model.defaults() | self.recipe.params
         return skin.skin_material(
             african=p["african"], asian=p["asian"], caucasian=p["caucasian"], age=p["age"]
         )
 
+    @property
+    def eye_colour(self) -> str:
+        """Avatar's iris colour (``looks.skin.IRIS_SRGB``) for the recipe's eye material."""
+        stem = Path(self.recipe.eye_material or DEFAULT_EYE_MATERIAL).stem.lower()
+        if stem not in EYE_COLOURS:
+            log.warning("eye material %s: unknown colour, brown eyes", self.recipe.eye_material)
+        return EYE_COLOURS.get(stem, "brown")
+
+    def _skin_file(self) -> Path | None:
+        """The recipe's skin ``.mhmat``: as given, or under an asset folder (also without
+        MakeHuman's ``skins/`` prefix); None for the default skin or when not found."""
+        name = self.recipe.skin_material
+        if not name or name == DEFAULT_SKIN_MATERIAL:
+            return None
+        relative = Path(name)
+        tails = [relative, *([Path(*relative.parts[1:])] if len(relative.parts) > 1 else [])]
+        folders = [Path(), *library.user_folders(self.recipe.folders)]
+        for folder in folders:
+            for tail in tails:
+                for candidate in (folder / tail, folder / "skins" / tail):
+                    if candidate.is_file():
+                        return candidate
+        log.warning("skin material %s not found in %s: Avatar's procedural skin is used", name,
+                    ", ".join(str(f) for f in folders))  # fmt: skip
+        return None
+
     # ------------------------------------------------------------------ MakeHuman files
     @classmethod
     def from_mhm(
-        cls, path: str | os.PathLike[str], model: BodyModel | None = None, rig: str | None = None
+        cls,
+        path: str | os.PathLike[str],
+        model: BodyModel | None = None,
+        rig: str | None = None,
+        folders: Sequence[str | os.PathLike[str]] = (),
     ) -> Human:
-        """A human from a MakeHuman ``.mhm`` character file (modifiers, skeleton, clothes)."""
-        return cls.from_recipe(Recipe.from_mhm(path, rig), model)
+        """A human from a MakeHuman ``.mhm`` character file (``Recipe.from_mhm``)."""
+        return cls.from_recipe(Recipe.from_mhm(path, rig, folders), model)
 
     def to_mhm(self, name: str = "avatar") -> mhm.CharacterFile:
-        """This human as a MakeHuman character file record (``avatar.io.mhm``)."""
-        out = mhm.CharacterFile(name=name, skeleton=f"{self.recipe.rig}.mhskel")
-        values = self.model.defaults() | self.recipe.params
-        for key, value in values.items():
+        """This human as a MakeHuman character file record (``avatar.io.mhm``): what a
+        ``.mhm`` read into it held, line for line, with the body, rig and garments as now.
+
+        Garments are written as MakeHuman writes its assets (``hair <name> <uuid>``,
+        ``clothes <name> <uuid>``, ...), built-ins under their fixed uuids.
+        """
+        r = self.recipe
+        out = mhm.loads("\n".join(f"{k} {v}" for k, v in r.mhm))  # the kept statements
+        out.text["name"] = r.name or name
+        out.skeleton = f"{r.rig}.mhskel"
+        missing = {k: v for k, v in self.model.defaults().items() if k not in r.params}
+        for key, value in (missing | r.params).items():
             p = self.model.parameters[key]
             if p.mhm_name:
                 out.modifiers[p.mhm_name] = value
             else:
                 out.avatar_params[key] = value
-        out.clothes = list(self.recipe.clothes)
+        worn = []
+        for garment in r.clothes:
+            entry = library.entry_of(garment, r.folders)
+            kind = library.mhm_kind(entry)
+            if kind != "clothes" and out.proxy(kind) is not None:
+                kind = "clothes"  # MakeHuman has one hair/eyebrows/eyelashes: the rest are clothes
+            ref = mhm.ProxyRef(kind, entry.name.replace(" ", "_"), entry.uuid)
+            out.proxies.append(ref)
+            worn.append(ref)
+        # Worn clothes first, in the recipe's order, then those kept from the file.
+        out.proxies = worn + [p for p in out.proxies if p not in worn]
+        eyes = out.proxy("eyes")
+        if eyes is None:
+            eyes = mhm.ProxyRef("eyes", *mhm.DEFAULT_EYES)
+            out.proxies.append(eyes)
+        eye_material = r.eye_material or DEFAULT_EYE_MATERIAL
+        out.materials.insert(0, mhm.MaterialRef(eyes.name, eyes.uuid, eye_material))
+        out.text["skinMaterial"] = r.skin_material or DEFAULT_SKIN_MATERIAL
+        for key, text in (("pose", r.pose), ("expression", r.expression)):
+            if text:
+                out.text[key] = text
+        if r.hide_covered is not None:
+            out.flags["clothesHideFaces"] = r.hide_covered
+        out.flags["subdivide"] = r.subdivide
         return out
 
 

@@ -13,6 +13,7 @@ arguments; each is scanned recursively for ``.mhclo`` files (see ``scan``).
 from __future__ import annotations
 
 import os
+import uuid
 from collections.abc import Iterable, Sequence
 from functools import lru_cache
 from pathlib import Path
@@ -24,11 +25,17 @@ from avatar.clothes.asset import read_garment
 from avatar.clothes.authoring import AuthoringBody
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.clothes.scan import LibraryEntry, scan
+from avatar.clothes.scan import entry as scan_entry
 from avatar.errors import AvatarError, unknown_name
 from avatar.part import MeshPart
 
 ENV_PATH = "AVATAR_CLOTHES_PATH"
 DEFAULT_OUTFIT = ("eyebrows", "eyelashes", "hair-short", "tshirt", "jeans", "shoes")
+# Built-ins have fixed uuids (so .mhm files name them as MakeHuman names its assets).
+_BUILTIN_NAMESPACE = uuid.UUID("6f1f8f5e-3c1a-4a8e-9a57-3e0d7c2b9a10")
+# MakeHuman's proxy libraries by asset category (the key of the asset's .mhm line).
+MHM_KIND = {"hair": "hair", "eyebrows": "eyebrows", "eyelashes": "eyelashes",
+            "proxymeshes": "proxy"}  # fmt: skip
 
 
 def user_folders(folders: Iterable[str | os.PathLike[str]] = ()) -> list[Path]:
@@ -37,11 +44,62 @@ def user_folders(folders: Iterable[str | os.PathLike[str]] = ()) -> list[Path]:
     return [Path(p) for p in [*folders, *env]]
 
 
+def builtin_uuid(name: str) -> str:
+    """The fixed uuid of a built-in garment (a name-based UUID 5)."""
+    return str(uuid.uuid5(_BUILTIN_NAMESPACE, name))
+
+
 def builtin_entries() -> list[LibraryEntry]:
     return [
-        LibraryEntry(s.name, s.category, s.tags, "builtin", "CC0", None, f"{s.fabric}, {s.colour}")
+        LibraryEntry(
+            s.name,
+            s.category,
+            s.tags,
+            "builtin",
+            "CC0",
+            None,
+            f"{s.fabric}, {s.colour}",
+            builtin_uuid(s.name),
+        )  # fmt: skip
         for s in builtin.SPECS
     ]
+
+
+def entry_of(name_or_path: str | os.PathLike[str],
+             folders: Iterable[str | os.PathLike[str]] = ()) -> LibraryEntry:  # fmt: skip
+    """The library entry (name, category, uuid, ...) of a garment as a recipe names it: a
+    built-in name, a ``.mhclo`` path or a user asset's name. Errors as ``find_garment``."""
+    source = find_garment(name_or_path, folders)
+    if source in builtin.BY_NAME:
+        return next(e for e in builtin_entries() if e.name == source)
+    return scan_entry(Path(source))
+
+
+def mhm_kind(item: LibraryEntry) -> str:
+    """The ``.mhm`` statement that names this asset: hair, eyebrows, eyelashes, proxy or
+    clothes (MakeHuman's library of that category)."""
+    if item.category in MHM_KIND:
+        return MHM_KIND[item.category]
+    if item.category == "face":  # the built-in eyebrows and eyelashes
+        return "eyebrows" if "eyebrows" in item.tags else "eyelashes"
+    return "clothes"
+
+
+def find_reference(
+    name: str, uuid_text: str = "", folders: Iterable[str | os.PathLike[str]] = ()
+) -> str | None:
+    """The garment a ``.mhm`` proxy line ``<kind> <name> <uuid>`` names: by uuid first
+    (MakeHuman's rule), then by name (MPFB's fallback: the asset's ``name`` line or file
+    stem), over built-ins, ``folders`` and ``$AVATAR_CLOTHES_PATH``. Returns a built-in name
+    or a ``.mhclo`` path, None when nothing matches."""
+    entries = list_garments(folders=folders)
+    found = [e for e in entries if uuid_text and e.uuid == uuid_text]
+    found = found or [
+        e for e in entries if name in (e.name, Path(e.source).stem if e.source != "builtin" else "")
+    ]
+    if not found:
+        return None
+    return found[0].name if found[0].source == "builtin" else found[0].source
 
 
 def list_garments(
@@ -141,10 +199,13 @@ __all__ = [
     "LibraryEntry",
     "Outfit",
     "dress",
+    "entry_of",
     "find_garment",
+    "find_reference",
     "garment_part",
     "list_garments",
     "load_garment",
+    "mhm_kind",
     "parts",
     "user_folders",
 ]

@@ -18,6 +18,8 @@ class LibraryEntry:
     """One garment in the library.
 
     source: "builtin" or the ``.mhclo`` path; thumbnail: a ``.thumb``/``.png`` path or None.
+    uuid: the asset's ``uuid`` line (MakeHuman's identity of an asset in ``.mhm`` files;
+    built-ins get a fixed one), "" when it has none.
     """
 
     name: str
@@ -27,6 +29,7 @@ class LibraryEntry:
     licence: str
     thumbnail: str | None
     description: str = ""
+    uuid: str = ""
 
     @property
     def haystack(self) -> str:
@@ -43,7 +46,7 @@ def scan(folder: str | os.PathLike[str]) -> list[LibraryEntry]:
 
 def entry(path: Path) -> LibraryEntry:
     """The entry of one ``.mhclo`` file from its header (keywords before the numbers)."""
-    name, tags, licence, description = path.stem, [], "", ""
+    name, tags, licence, description, uuid = path.stem, [], "", "", ""
     try:
         with open(path, encoding="utf-8", errors="replace") as f:
             for line in f:
@@ -61,13 +64,14 @@ def entry(path: Path) -> LibraryEntry:
                     licence = rest
                 elif words[0] == "description":
                     description = rest
+                elif words[0] == "uuid":
+                    uuid = rest
                 elif words[0].startswith("#") and "CC0" in line and not licence:
                     licence = "CC0"
     except OSError as exc:
         description = f"unreadable: {exc.strerror}"
-    return LibraryEntry(
-        name, _category(path), tuple(tags), str(path), licence, _thumbnail(path), description
-    )
+    return LibraryEntry(name, _category(path), tuple(tags), str(path), licence,
+                        _thumbnail(path), description, uuid)  # fmt: skip
 
 
 def _category(path: Path) -> str:
