@@ -1,5 +1,8 @@
 """The `avatar` command end to end (in-process)."""
 
+import os
+import re
+
 import numpy as np
 import pytest
 
@@ -59,3 +62,115 @@ def test_create_resolves_garments_in_animations_unless_told_not_to(tmp_path, mod
     ((args, kwargs),) = calls
     assert kwargs["resolve_garments"] is resolve and kwargs["progress"] is True
     assert args[0].recipe.clothes == ("tshirt",) and args[2].frames == 8
+
+
+def _one_line_error(capsys) -> str:
+    """The command's stderr: exactly one ``avatar: error: ...`` line, no traceback."""
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("avatar: error: "), err
+    assert "Traceback" not in err[0]
+    return err[0]
+
+
+@pytest.mark.parametrize("fps", ["-5", "0", "nan", "inf", "fast"])
+def test_create_refuses_a_non_positive_fps_as_a_usage_error(tmp_path, capsys, fps):
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(["create", "--motion", "walk", "--fps", fps, "-o", str(tmp_path / "w.glb")])
+    assert exit_.value.code == 2
+    assert "--fps" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("where", "words"),
+    [
+        (lambda tmp: tmp / "missing" / "h.glb", "does not exist"),  # a folder that is not there
+        (lambda tmp: tmp / "file.txt" / "h.glb", "is a file"),  # a path under a file
+        (lambda tmp: tmp, "is a folder"),  # a folder, not a file
+    ],
+)
+def test_create_refuses_outputs_it_cannot_write_before_any_work(tmp_path, capsys, monkeypatch,
+                                                                where, words):  # fmt: skip
+    import avatar.cli.create
+
+    (tmp_path / "file.txt").write_text("x")
+    built = []
+    monkeypatch.setattr(avatar.cli.create, "BodyModel", lambda *a: built.append(a))
+    assert cli.main(["create", "-o", str(where(tmp_path))]) == 1
+    line = _one_line_error(capsys)
+    assert words in line and str(where(tmp_path)) in line
+    assert not built  # refused before the body model was even loaded
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file.txt"]
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="root writes anywhere")
+def test_create_refuses_a_read_only_folder(tmp_path, capsys):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        assert cli.main(["create", "-o", str(folder / "h.glb")]) == 1
+        assert "not writable" in _one_line_error(capsys)
+    finally:
+        folder.chmod(0o700)
+
+
+def test_a_write_that_fails_anyway_is_one_line(tmp_path, capsys, monkeypatch, model):
+    """An OSError at write time (disk full, a folder removed meanwhile) is one line too."""
+    import avatar.export
+
+    def full(*args, **kwargs):
+        raise OSError(28, "No space left on device", str(tmp_path / "h.obj"))
+
+    monkeypatch.setattr(avatar.export, "save", full)
+    assert cli.main(["create", "-o", str(tmp_path / "h.obj")]) == 1
+    assert "No space left on device" in _one_line_error(capsys)
+
+
+def test_create_refuses_a_missing_motion_or_character_file(tmp_path, capsys):
+    out = tmp_path / "h.glb"
+    assert cli.main(["create", "--motion", str(tmp_path / "missing.bvh"), "-o", str(out)]) == 1
+    line = _one_line_error(capsys)
+    assert "missing.bvh" in line and "no such file" in line and "walk" in line
+    assert cli.main(["create", str(tmp_path / "me.mhm"), "-o", str(out)]) == 1
+    assert "me.mhm" in _one_line_error(capsys)
+    assert not list(tmp_path.iterdir())
+
+
+def test_unreachable_measurements_name_the_reachable_range(tmp_path, capsys, model):
+    out = tmp_path / "t.obj"
+    assert cli.main(["create", "--measure", "height=400", "-o", str(out)]) == 1
+    line = _one_line_error(capsys)
+    low, high = (float(v) for v in re.search(r"ranges ([\d.]+)-([\d.]+) cm", line).groups())
+    assert "height 400 cm is out of reach" in line and 100 < low < 160 < 200 < high < 260
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("value", ["-5", "0", "nan"])
+def test_non_positive_measurements_are_errors(tmp_path, capsys, value):
+    assert cli.main(["create", "--measure", f"waist={value}", "-o", str(tmp_path / "t.obj")]) == 1
+    assert "--measure waist: a measurement is a positive length in cm" in _one_line_error(capsys)
+    assert not list(tmp_path.iterdir())
+
+
+def _cube_obj(path, corner, size):
+    """A closed cube OBJ (metres, Avatar's frame) with one corner at ``corner``."""
+    lines = [f"v {corner[0] + x} {corner[1] + y} {corner[2] + z}"
+             for x in (0, size) for y in (0, size) for z in (0, size)]  # fmt: skip
+    lines += ["f 1 2 4 3", "f 5 7 8 6", "f 1 5 6 2", "f 3 4 8 7", "f 1 3 7 5", "f 2 6 8 4"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("frame", [[], ["--frame", "avatar"], ["--frame", "makehuman"]])
+def test_binding_a_mesh_far_from_the_body_is_an_error_naming_the_limit(tmp_path, capsys,
+                                                                       model, frame):  # fmt: skip
+    far = _cube_obj(tmp_path / "far.obj", (10.0, 0.0, 1.0), 0.5)  # 10 m beside the body
+    out = tmp_path / "garments"
+    assert cli.main(["clothes", "bind", str(far), "-o", str(out), *frame]) == 1
+    line = _one_line_error(capsys)
+    assert "far.obj" in line and "limit 0.5 m" in line
+    assert not out.exists()
+    near = _cube_obj(tmp_path / "near.obj", (-0.15, -0.2, 1.0), 0.3)  # around the chest
+    assert cli.main(["clothes", "bind", str(near), "-o", str(out)]) == 0
+    assert (out / "near.mhclo").is_file()

@@ -198,3 +198,40 @@ def test_every_fixture_clip_loads_upright_and_human_sized(clip):
     assert 0.5 < up < 2.0, (skeleton.extra, up)  # head above feet (crouches too), metres
     data = bvh.read(clip)
     assert bvh.loads(bvh.dumps(data)).motion.shape == data.motion.shape
+
+
+@pytest.mark.parametrize(
+    "motion",
+    [
+        "MOTION\n\nFrames: 2\nFrame Time: .0333333\n",  # a blank line after MOTION
+        "MOTION\r\n\r\nFrames: 2\r\n\r\nFrame Time: .0333333\r\n\r\n",  # blank lines anywhere
+        "MOTION  \n \t \nFrames: 2\nFrame Time: .0333333\n",  # whitespace-only lines
+    ],
+)
+def test_blank_lines_in_the_motion_header_are_accepted(motion):
+    text = SMALL.replace("MOTION\nFrames: 2\nFrame Time: .0333333\n", motion)
+    assert text != SMALL
+    data, reference = bvh.loads(text), bvh.loads(SMALL)
+    assert data.frames == 2 and data.frame_time == reference.frame_time
+    assert np.array_equal(data.motion, reference.motion)
+
+
+def test_a_bad_row_after_blank_lines_is_reported_on_its_own_line():
+    text = SMALL.replace("MOTION\n", "MOTION\n\n\n").replace("0 91 0", "0 9x1 0")
+    with pytest.raises(FormatError) as err:
+        bvh.loads(text, path="clip.bvh")
+    assert err.value.line == 31 and "not a number" in err.value.message
+
+
+def test_zero_frames_read_as_a_hierarchy_and_refused_as_a_clip(tmp_path):
+    text = SMALL[: SMALL.index("Frames")] + "Frames: 0\nFrame Time: .0333333\n"
+    data = bvh.loads(text)  # a valid file: the hierarchy without motion
+    assert data.frames == 0 and data.motion.shape == (0, 15)
+    skeleton, empty = bvh.to_animation(data, unit="cm", up="y")  # a valid empty clip
+    assert empty.rotations.shape == (0, 3, 4) and len(skeleton.names) == 3
+    path = tmp_path / "empty.bvh"
+    path.write_text(text)
+    with pytest.raises(FormatError) as err:  # but nothing to load as a clip
+        bvh.load(path)
+    assert err.value.line == 26 and "Frames: 0" in str(err.value)
+    assert str(err.value).startswith(f"{path}:26: ")

@@ -141,16 +141,23 @@ def fit(
     params: Mapping[str, float] | None = None,
     iterations: int = 8,
     tolerance: float = 0.002,
+    reach: float | None = 0.01,
 ) -> tuple[dict[str, float], dict[str, float]]:
     """Solve for parameters giving target measurements (metres: height, chest, waist, hips).
 
     Damped Gauss-Newton over the ``DRIVERS`` of the requested measurements, starting from
-    ``params``; parameters stay within their ranges, so an unreachable target ends at the
-    nearest reachable value. Returns (parameters, achieved measurements).
+    ``params``; parameters stay within their ranges. A target the solve ends further than
+    ``reach`` metres from is unreachable: ParameterError naming the range its driver spans
+    (the other measurements as solved); ``reach=None`` keeps the nearest reachable value
+    instead. Non-finite or non-positive targets are ParameterErrors too.
+    Returns (parameters, achieved measurements).
     """
     unknown = set(targets) - set(DRIVERS)
     if unknown:
         raise ParameterError(f"cannot fit {', '.join(sorted(unknown))}; use {', '.join(DRIVERS)}")
+    for name, value in targets.items():
+        if not np.isfinite(value) or value <= 0:
+            raise ParameterError(f"measurement {name} must be a positive length, got {value:g} m")
     names = list(targets)
     drivers = [DRIVERS[n] for n in names]
     values = dict(model.resolve(params))
@@ -176,4 +183,17 @@ def fit(
         x = np.clip(x + np.clip(delta, -0.5, 0.5), lo, hi)
         current = evaluate(x)
     values |= dict(zip(drivers, x.tolist(), strict=True))
+    if reach is not None:
+        for k in np.flatnonzero(np.abs(current - want) > reach):
+            ends = []
+            for bound in (lo[k], hi[k]):  # the driver at each end of its range
+                probe = x.copy()
+                probe[k] = bound
+                ends.append(float(evaluate(probe)[k]))
+            low, high = min(ends), max(ends)
+            raise ParameterError(
+                f"{names[k]} {want[k] * 100:g} cm is out of reach: this body's {names[k]} "
+                f"ranges {low * 100:.1f}-{high * 100:.1f} cm (parameter {drivers[k]} "
+                f"{lo[k]:g}..{hi[k]:g}; the closest is {current[k] * 100:.1f} cm)"
+            )
     return values, dict(zip(names, current.tolist(), strict=True))

@@ -11,7 +11,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from avatar.cli import clothes, create, info, motion
+from avatar.cli import clothes, create, info, motion, paths
 from avatar.errors import AvatarError
 
 
@@ -28,6 +28,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.run(args) or 0)
     except AvatarError as exc:
         print(f"avatar: error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:  # a write the checks up front could not foresee (disk full, ...)
+        print(f"avatar: error: {paths.os_error(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("avatar: interrupted", file=sys.stderr)

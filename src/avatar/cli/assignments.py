@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from avatar.errors import ParameterError
@@ -18,4 +19,16 @@ def parse_assignments(items: Sequence[str], flag: str = "--set") -> dict[str, fl
             out[name.strip()] = float(value)
         except ValueError:
             raise ParameterError(f"{flag} {name}: {value!r} is not a number") from None
+    return out
+
+
+def parse_measurements(items: Sequence[str]) -> dict[str, float]:
+    """``--measure`` options ["height=180", "waist=85"] (cm) -> {"height": 1.8, ...} in
+    metres; a measurement that is not a positive finite length is a ParameterError."""
+    out = {}
+    for name, cm in parse_assignments(items, "--measure").items():
+        if not math.isfinite(cm) or cm <= 0:
+            raise ParameterError(f"--measure {name}: a measurement is a positive length in cm, "
+                                 f"got {cm:g}")  # fmt: skip
+        out[name] = cm / 100.0
     return out

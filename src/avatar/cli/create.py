@@ -14,8 +14,8 @@ from pathlib import Path
 from avatar import export
 from avatar.body import measures
 from avatar.body.model import BodyModel
-from avatar.cli import motion
-from avatar.cli.assignments import parse_assignments
+from avatar.cli import motion, paths
+from avatar.cli.assignments import parse_assignments, parse_measurements
 from avatar.clothes import library
 from avatar.human import Human, Recipe
 from avatar.motion.procedural import MOTIONS
@@ -70,6 +70,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    _check_paths(args)
     model = BodyModel.shared(progress=True)
     human = Human.from_recipe(_recipe(args, model), model)
     animation, name = _animation(human, args)
@@ -82,6 +83,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_paths(args: argparse.Namespace) -> None:
+    """Every file named on the command line, before any work: inputs exist, outputs can be
+    written (``cli.paths``); raises AvatarError naming the path."""
+    paths.output_file(args.output)
+    if args.render:
+        paths.output_file(args.render, "picture")
+    if args.character:
+        paths.input_file(args.character, "character file")
+    if args.motion and args.motion not in MOTIONS:
+        paths.input_file(args.motion, "--motion", f"a .bvh clip or {', '.join(MOTIONS)}")
+
+
 def _recipe(args: argparse.Namespace, model: BodyModel) -> Recipe:
     """The whole recipe from the options, every name checked, measurements solved."""
     for name in args.wear:  # fail early, naming the unknown garment, before any fitting
@@ -89,7 +102,7 @@ def _recipe(args: argparse.Namespace, model: BodyModel) -> Recipe:
     recipe = Recipe.from_mhm(args.character) if args.character else Recipe()
     params = model.resolve(recipe.params | parse_assignments(args.set))
     if args.measure:
-        wanted = {k: v / 100.0 for k, v in parse_assignments(args.measure, "--measure").items()}
+        wanted = parse_measurements(args.measure)
         params, got = measures.fit(model, wanted, params)
         log.info("measurements: %s", ", ".join(f"{k} {v * 100:.1f} cm" for k, v in got.items()))
     clothes = tuple(dict.fromkeys(recipe.clothes + tuple(args.wear)))

@@ -5,14 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from avatar.body.shaped import Body
-from avatar.errors import ParameterError
+from avatar.cli import paths
+from avatar.errors import AvatarError, ParameterError
 from avatar.human import Human
-from avatar.io import bvh
+from avatar.io import atomic, bvh
 from avatar.motion import floor, poselib, timing
 from avatar.motion.retarget import RetargetReport, retarget
 from avatar.rig.skeleton import Animation, Skeleton
@@ -40,7 +42,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def add_motion_arguments(parser: argparse.ArgumentParser) -> None:
     """Options shared by ``create --motion`` and ``retarget``."""
     parser.add_argument("--frames", metavar="A:B", help="source frames to keep (B exclusive)")
-    parser.add_argument("--fps", type=float, help="output frame rate (default: the clip's)")
+    parser.add_argument(
+        "--fps", type=paths.positive_number, help="output frame rate (default: the clip's)"
+    )
     parser.add_argument("--in-place", action="store_true", help="remove horizontal root motion")
     parser.add_argument("--no-foot-fix", action="store_true", help="skip contact planting (IK)")
     parser.add_argument("--rest", metavar="POSE",
@@ -64,12 +68,16 @@ def add_retarget_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def clip_paths(inputs: list[str]) -> list[Path]:
-    """Files as given, folders expanded to their ``*.bvh`` files (sorted, recursive)."""
+    """Files as given, folders expanded to their ``*.bvh`` files (sorted, recursive).
+    Raises ParameterError for a missing path or a folder without any ``.bvh`` file."""
     out: list[Path] = []
     for item in inputs:
         path = Path(item)
         if path.is_dir():
-            out.extend(sorted(path.rglob("*.bvh")))
+            found = sorted(p for p in path.rglob("*") if p.suffix.lower() == ".bvh")
+            if not found:
+                raise ParameterError(f"no .bvh clips in folder {item!r}")
+            out.extend(found)
         elif path.exists():
             out.append(path)
         else:
@@ -80,7 +88,7 @@ def clip_paths(inputs: list[str]) -> list[Path]:
 def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
                ) -> tuple[Animation, RetargetReport]:  # fmt: skip
     """Retarget one clip onto ``target`` with the options of ``add_motion_arguments``."""
-    source, animation = bvh.load(clip)
+    source, animation = bvh.load(paths.input_file(clip, "clip"))
     return retarget(
         source,
         animation,
@@ -94,24 +102,47 @@ def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
 
 
 def run_retarget(args: argparse.Namespace) -> int:
-    """Every clip onto one rig: a BVH per clip plus a quality line (and a JSON report)."""
+    """Every clip onto one rig: a BVH per clip plus a quality line (and a JSON report).
+
+    A clip that fails (a broken file, a skeleton that is not a human) is reported on one
+    line and skipped; the others are written and reported. Exit status 1 when any failed.
+    """
+    clips = clip_paths(args.clips)
+    out = paths.output_folder(args.out)
+    if args.report:
+        paths.output_file(args.report, "report")
+    timing.parse_frames(args.frames)  # a bad range fails once, not once per clip
     human = Human(rig=args.rig)
     target = human.skeleton
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    table = {}
-    for clip in clip_paths(args.clips):
-        animation, report = motion_for(target, clip, args)
-        animation, ground = on_floor(human.body, animation, args.keep_height)
-        skeleton = target
-        if args.rest:
-            skeleton, animation = poselib.switch_rest(target, animation, args.rest)
-        bvh.save(out / clip.name, skeleton, animation)
-        print(f"{clip.name}: {report.summary()}\n{ground.summary()}")
-        table[str(clip)] = _row(report) | {"floor": ground.as_dict()}
+    table: dict[str, dict] = {}
+    for clip in clips:
+        try:
+            row = _retarget_one(human, target, clip, out, args)
+        except AvatarError as exc:
+            print(f"avatar: error: {clip}: {exc}", file=sys.stderr)
+            table[str(clip)] = {"error": str(exc)}
+            continue
+        table[str(clip)] = row
     if args.report:
-        Path(args.report).write_text(json.dumps(table, indent=1) + "\n", encoding="utf-8")
-    return 0
+        atomic.write_text(args.report, json.dumps(table, indent=1) + "\n")
+    failed = sum("error" in row for row in table.values())
+    if failed:
+        print(f"avatar: error: {failed} of {len(table)} clips failed", file=sys.stderr)
+    return 1 if failed else 0
+
+
+def _retarget_one(human: Human, target: Skeleton, clip: Path, out: Path,
+                  args: argparse.Namespace) -> dict:  # fmt: skip
+    """One clip of ``run_retarget``: its BVH written, its line printed; its report row."""
+    animation, report = motion_for(target, clip, args)
+    animation, ground = on_floor(human.body, animation, args.keep_height)
+    skeleton = target
+    if args.rest:
+        skeleton, animation = poselib.switch_rest(target, animation, args.rest)
+    bvh.save(out / clip.name, skeleton, animation)
+    print(f"{clip.name}: {report.summary()}\n{ground.summary()}")
+    return _row(report) | {"floor": ground.as_dict()}
 
 
 def _row(report: RetargetReport) -> dict:

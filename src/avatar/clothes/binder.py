@@ -25,13 +25,15 @@ from avatar.mesh import Mesh
 # MakeHuman's standard reference pairs (x: hand to hand width, y: front-back, z: height),
 # as Avatar axes; the lengths are measured on the authoring body.
 SCALE_REFS = np.array([[5399, 11998], [962, 5320], [791, 881]], dtype=np.int32)
+MAX_DISTANCE = 0.5  # m: the farthest a garment vertex may be from the authoring body's skin
+MIN_GARMENT_SIZE = 0.02  # m: the smallest extent a frame may give a garment (lashes ~0.04)
 
 
 def bind(
     garment_vertices: np.ndarray,
     body_vertices: np.ndarray,
     body_faces: np.ndarray,
-    max_distance: float = 0.5,
+    max_distance: float = MAX_DISTANCE,
 ) -> Binding:
     """A Binding of N garment vertices to the body they were modelled on.
 
@@ -123,8 +125,9 @@ def in_body_frame(
 ) -> tuple[np.ndarray, str]:
     """(N, 3) garment vertices in Avatar's frame, and the frame they came in.
 
-    frame: a ``FRAMES`` name, or "auto": the one that puts the garment closest to the
-    body (median distance to its nearest body vertex).
+    frame: a ``FRAMES`` name, or "auto": of the frames giving the mesh at least garment
+    size (``MIN_GARMENT_SIZE``), the one that puts it closest to the body (median distance
+    to its nearest body vertex).
     """
     v = np.asarray(vertices, dtype=np.float64)
     if frame != "auto":
@@ -133,9 +136,15 @@ def in_body_frame(
         scale, y_up = FRAMES[frame]
         out = np.stack([v[:, 0], -v[:, 2], v[:, 1]], axis=1) if y_up else v
         return out * scale, frame
+    if v.ndim != 2 or v.shape[1] != 3 or len(v) == 0 or not np.all(np.isfinite(v)):
+        raise AvatarError("a garment needs (N, 3) finite vertex positions")
     tree = cKDTree(np.asarray(body_vertices, dtype=np.float64))
     tries = {name: in_body_frame(v, body_vertices, name)[0] for name in FRAMES}
-    gap = {name: float(np.median(tree.query(p)[0])) for name, p in tries.items()}
+    # A reading that makes the mesh smaller than any garment is not a candidate: a mesh far
+    # from the body read in centimetres shrinks to a speck that lands close to the body.
+    sizes = {name: float(np.ptp(p, axis=0).max()) for name, p in tries.items()}
+    plausible = [n for n in FRAMES if sizes[n] >= MIN_GARMENT_SIZE] or list(FRAMES)
+    gap = {name: float(np.median(tree.query(tries[name])[0])) for name in plausible}
     best = min(gap, key=gap.__getitem__)
     return tries[best], best
 
@@ -159,9 +168,12 @@ def bind_obj(
     name = name or path.stem
     mesh = obj.read(path)
     authored = np.asarray(body.vertices, dtype=np.float64)
-    vertices, _ = in_body_frame(mesh.vertices, authored, frame)
+    vertices, found = in_body_frame(mesh.vertices, authored, frame)
     base = body.model.base
-    binding = bind(vertices, authored, base.faces[base.face_groups["body"]])
+    try:
+        binding = bind(vertices, authored, base.faces[base.face_groups["body"]])
+    except AvatarError as exc:
+        raise AvatarError(f"{path}: {exc} (read as frame {found!r})") from None
     entries = [("name", name), ("diffuseColor", "0.8 0.8 0.8")]
     if texture is not None and not Path(texture).is_file():
         raise AvatarError(f"{texture}: texture file not found")
@@ -172,4 +184,3 @@ def bind_obj(
     if texture is not None:
         shutil.copyfile(texture, Path(folder) / entries[-1][1])
     return out
-

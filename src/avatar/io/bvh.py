@@ -194,36 +194,41 @@ def _parse_channels(tokens: _Tokens) -> tuple[str, ...]:
     return tuple(names)
 
 
-_FRAMES = re.compile(r"^\s*Frames\s*:?\s*(\S+)\s*$", re.IGNORECASE)
+_FRAMES = re.compile(r"^[ \t]*Frames[ \t]*:?[ \t]*(\S+)[ \t]*$", re.IGNORECASE | re.MULTILINE)
 _FRAME_TIME = re.compile(r"^\s*Frame\s*Time\s*:?\s*(\S+)\s*$", re.IGNORECASE)
 
 
 def _header_value(lines: list[str], n: int, pattern: re.Pattern, what: str, base: int, path):
+    """The value of the header line ``what`` at or after ``lines[n]`` (blank lines before it
+    are skipped: real exporters write them after ``MOTION``). Returns (value, index)."""
+    while n < len(lines) and not lines[n].strip():
+        n += 1
     if n >= len(lines):
         raise FormatError(path, base + n, f"file ends before '{what}'")
     match = pattern.match(lines[n])
     if not match:
         found = lines[n].strip()
         raise FormatError(path, base + n, f"expected '{what}: <value>', found {found!r}")
-    return match.group(1)
+    return match.group(1), n
 
 
-def _parse_motion_header(lines: list[str], base: int, path) -> tuple[int, float]:
-    """``lines[0:2]`` (file lines ``base``, ``base + 1``) -> (frames, frame time in seconds)."""
-    raw = _header_value(lines, 0, _FRAMES, "Frames", base, path)
+def _parse_motion_header(lines: list[str], base: int, path) -> tuple[int, float, int]:
+    """The lines after ``MOTION`` (the first is file line ``base``) -> (frames, frame time in
+    seconds, index in ``lines`` of the first line after the header)."""
+    raw, n = _header_value(lines, 0, _FRAMES, "Frames", base, path)
     if not raw.isdigit():
-        raise FormatError(path, base, f"frame count {raw!r} is not a whole number")
-    raw_time = _header_value(lines, 1, _FRAME_TIME, "Frame Time", base, path)
+        raise FormatError(path, base + n, f"frame count {raw!r} is not a whole number")
+    raw_time, n = _header_value(lines, n + 1, _FRAME_TIME, "Frame Time", base, path)
     try:
         frame_time = float(raw_time.replace(",", "."))
     except ValueError:
-        raise FormatError(path, base + 1, f"frame time {raw_time!r} is not a number") from None
+        raise FormatError(path, base + n, f"frame time {raw_time!r} is not a number") from None
     if not np.isfinite(frame_time) or frame_time <= 0:
-        raise FormatError(path, base + 1, f"frame time must be positive, got {raw_time!r}")
+        raise FormatError(path, base + n, f"frame time must be positive, got {raw_time!r}")
     if frame_time >= 1.0:  # a few exporters write frames per second here
         log.warning("%s: Frame Time %s read as frames per second", path, raw_time)
         frame_time = 1.0 / frame_time
-    return int(raw), frame_time
+    return int(raw), frame_time, n + 1
 
 
 def _parse_numbers(text: str, frames: int, width: int, first_line: int, path) -> np.ndarray:
@@ -277,11 +282,11 @@ def loads(text: str, path: str | os.PathLike[str] | None = None) -> BvhData:
     if tokens.pos != len(tokens.items):
         raise tokens.error(f"unexpected {tokens.items[tokens.pos][0]!r} after the hierarchy")
     motion_line = len(head)  # 1-based line number of "MOTION"
-    lines = text[match.end() :].split("\n", 3)[1:]
-    frames, frame_time = _parse_motion_header(lines, motion_line + 1, path)
+    lines = text[match.end() :].split("\n")[1:]
+    frames, frame_time, first = _parse_motion_header(lines, motion_line + 1, path)
     width = sum(len(c) for c in h["channels"])
-    data = lines[2] if len(lines) > 2 else ""
-    motion = _parse_numbers(data, frames, width, motion_line + 3, path)
+    data = "\n".join(lines[first:])
+    motion = _parse_numbers(data, frames, width, motion_line + 1 + first, path)
     return BvhData(
         names=tuple(h["names"]),
         parents=np.array(h["parents"], dtype=np.int32),
@@ -396,7 +401,7 @@ def local_rotations(data: BvhData) -> np.ndarray:
     q[..., 0] = 1.0
     joints, cols = _euler_columns(data)
     for order, js in joints.items():
-        angles = np.radians(data.motion[:, cols[order]]).reshape(data.frames, len(js), -1)
+        angles = np.radians(data.motion[:, cols[order]]).reshape(data.frames, len(js), len(order))
         if len(order) == 3:
             # from_euler's order lists the innermost rotation first: reverse the channels.
             q[:, js] = quaternion.from_euler(angles[..., ::-1], order[::-1])
@@ -668,8 +673,24 @@ def from_animation(skeleton: Skeleton, animation: Animation, unit: str | float =
 
 def load(path: str | os.PathLike[str], unit: str | float = "auto", up: str = "auto",
          positions: str = "auto") -> tuple[Skeleton, Animation]:  # fmt: skip
-    """Read a BVH file as Avatar ``Skeleton`` and ``Animation``; see ``to_animation``."""
-    return to_animation(read(path), unit, up, positions)
+    """Read a BVH file as Avatar ``Skeleton`` and ``Animation``; see ``to_animation``.
+
+    Raises FormatError for a file with ``Frames: 0`` (a hierarchy without motion is a valid
+    file for ``read``, but not a clip: there is no frame to load, pose or retarget).
+    """
+    data = read(path)
+    if data.frames == 0:
+        raise FormatError(path, _frames_line(path), "'Frames: 0': the file has no motion "
+                          "to load (a clip needs at least one frame)")  # fmt: skip
+    return to_animation(data, unit, up, positions)
+
+
+def _frames_line(path: str | os.PathLike[str]) -> int:
+    """1-based line number of the ``Frames:`` header (0 when not found)."""
+    text = Path(path).read_bytes().decode("latin-1")
+    motion = re.search(r"^[ \t]*MOTION[ \t]*$", text, re.MULTILINE | re.IGNORECASE)
+    found = _FRAMES.search(text, motion.end() if motion else 0) if motion else None
+    return text.count("\n", 0, found.start()) + 1 if found else 0
 
 
 def save(path: str | os.PathLike[str], skeleton: Skeleton, animation: Animation,

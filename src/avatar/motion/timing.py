@@ -24,7 +24,10 @@ def parse_frames(text: str | None) -> slice | None:
 
 
 def select(animation: Animation, frames: slice | None) -> Animation:
-    """The frames in ``frames`` (a slice); raises ParameterError when it selects nothing."""
+    """The frames in ``frames`` (a slice); raises ParameterError when it selects nothing
+    (or the animation has no frame at all)."""
+    if animation.frames == 0:
+        raise ParameterError("the clip has no frames")
     if frames is None:
         return animation
     rot, trans = animation.rotations[frames], animation.translations[frames]
