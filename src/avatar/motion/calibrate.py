@@ -161,9 +161,15 @@ def _choose(out: np.ndarray, pairs: list[Pair], source: Skeleton, target: Skelet
             ref[j] = base
             continue
         p, rt = pairs[k], target.rest[pairs[k].target, :3, :3]
-        e_s = segment_rest(source, p.source, p.source_end)
-        want = rt @ segment_rest(target, p.target, p.target_end)
-        g = _swing(base @ e_s, want) @ base
+        if p.role.startswith("="):
+            # A same-named bone is the same bone of one rig family: it keeps its rest
+            # relation to its parent. Its segment says nothing more (own tails are
+            # invented by BVH readers; child joints differ with the body's shape).
+            g = base
+        else:
+            e_s = segment_rest(source, p.source, p.source_end)
+            want = rt @ segment_rest(target, p.target, p.target_end)
+            g = _swing(base @ e_s, want) @ base
         rest_aligned = g.T @ rt
         if np.isnan(out[k, 0, 0]) or _degrees(rest_aligned, out[k]) < REST_TRUST:
             out[k] = rest_aligned

@@ -59,15 +59,42 @@ def _end_index(bmap: BoneMap, end) -> int:
     return bmap.bones[end]
 
 
+def _landmark(source: Skeleton, s: int, target: Skeleton, t: int) -> tuple[int, int] | None:
+    """(source child, target child): the same-named child joints of bones ``s`` and ``t``
+    farthest from their joint on the target (at least ``_MIN_SEGMENT`` away on both), or
+    None. A child joint is a point of the anatomy both skeletons place; a bone's own tail
+    is not (a BVH file has no tails: readers invent one from an End Site or the mean of
+    the children, which for a head with a face is a point inside the skull)."""
+    kids_s = {bonemap.normalise(source.names[c]): c for c in np.flatnonzero(source.parents == s)}
+    best, far = None, _MIN_SEGMENT
+    for c in np.flatnonzero(target.parents == t):
+        o = kids_s.get(bonemap.normalise(target.names[c]))
+        if o is None:
+            continue
+        gaps = (np.linalg.norm(source.heads[o] - source.heads[s]),
+                np.linalg.norm(target.heads[c] - target.heads[t]))  # fmt: skip
+        if min(gaps) > _MIN_SEGMENT and gaps[1] > far:
+            best, far = (int(o), int(c)), float(gaps[1])
+    return best
+
+
 def make_pairs(
     source: Skeleton, smap: BoneMap, target: Skeleton, tmap: BoneMap, match_names: bool = True
 ) -> list[Pair]:
-    """Canonical pairs (roles mapped on both sides), then same-named leftovers."""
+    """Canonical pairs (roles mapped on both sides), then same-named leftovers.
+
+    A segment that would end at the bones' own tails (the head, the last bone of a
+    chain, same-named extras) ends instead at a same-named child joint where both
+    skeletons have one (``_landmark``: the face's joints for the head).
+    """
     pairs = []
     for role in bonemap.NEXT:
         if role in smap.bones and role in tmap.bones:
             end = _end_role(source, smap, target, tmap, role)
             s_end, t_end = _end_index(smap, end), _end_index(tmap, end)
+            mark = _landmark(source, smap.bones[role], target, tmap.bones[role])
+            if end is None and mark is not None:
+                s_end, t_end = mark
             pairs.append(Pair(role, smap.bones[role], tmap.bones[role], s_end, t_end))
     if match_names:
         used_s = {p.source for p in pairs}
@@ -76,7 +103,8 @@ def make_pairs(
         for t, name in enumerate(target.names):
             s = index.get(bonemap.normalise(name))
             if s is not None and s not in used_s and t not in used_t:
-                pairs.append(Pair("=" + name, s, t, -1, -1))
+                s_end, t_end = _landmark(source, s, target, t) or (-1, -1)
+                pairs.append(Pair("=" + name, s, t, s_end, t_end))
     return pairs
 
 
