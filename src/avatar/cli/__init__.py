@@ -11,7 +11,8 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from avatar.cli import clothes, create, info, motion, paths
+from avatar.cli import clothes, create, dataset, info, motion, paths
+from avatar.cli import mocap
 from avatar.errors import AvatarError
 
 
@@ -49,4 +50,6 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_parser(sub)
     motion.add_parsers(sub)
     clothes.add_parsers(sub)
+    mocap.add_parsers(sub)
+    dataset.add_parsers(sub)
     return parser
