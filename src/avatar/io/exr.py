@@ -19,7 +19,8 @@ def _openexr():
     try:
         import OpenEXR
     except ImportError:  # pragma: no cover - depends on the environment
-        raise AvatarError("EXR files need the OpenEXR package: pip install 'avatar[dataset]'") from None
+        raise AvatarError("EXR files need the OpenEXR package: "
+                          "pip install 'avatar[dataset]'") from None
     return OpenEXR
 
 
