@@ -1,12 +1,14 @@
 """Planted feet for the streaming solver: contact detection and two-bone leg IK.
 
 A foot is in contact while its ankle is within ``height`` of the lowest ankle level seen
-(the floor) and moves slower than ``speed`` m/s. At contact start the ankle's position is
-pinned; while the contact lasts the leg is bent (thigh and shin, the foot keeping its world
-rotation) so the ankle stays on the pin; at release the correction fades with time
-constant ``release`` seconds instead of snapping. A pin the ankle has left by more than
-``reach`` metres is dropped and set again (a slow slide is followed, in steps). This
-removes the foot skating and jitter that estimators leave on standing feet.
+(the floor) and moves slower than ``speed`` m/s (measured on the ankle path smoothed with
+a 0.1 s time constant, so an estimator's jitter does not read as motion). At contact
+start the ankle's position is pinned; while the contact lasts the leg is bent (thigh and
+shin, the foot keeping its world rotation) so the ankle stays on the pin; at release the
+correction fades with time constant ``release`` seconds instead of snapping. A pin the
+ankle has left by more than ``reach`` metres is dropped and set again (a slow slide is
+followed, in steps). This removes the foot skating and jitter that estimators leave on
+standing feet.
 """
 
 from __future__ import annotations
@@ -44,13 +46,14 @@ class FootPlanter:
         if ankles:
             self.floor = min(self.floor, min(float(a[2]) for a in ankles))
         for side, leg in enumerate(self.legs):
-            if leg is None or not f.solved[leg[2]]:
+            if leg is None or not f.solved[leg[1]]:  # the shin places the ankle
                 self.pins[side], self.previous[side] = None, None
                 continue
             ankle = f.heads[leg[2]].copy()
             prev = self.previous[side]
-            self.previous[side] = ankle
-            speed = math.inf if prev is None else float(np.linalg.norm(ankle - prev)) / dt
+            smooth = ankle if prev is None else prev + (1 - math.exp(-dt / 0.1)) * (ankle - prev)
+            self.previous[side] = smooth
+            speed = math.inf if prev is None else float(np.linalg.norm(smooth - prev)) / dt
             down = ankle[2] - self.floor < self.height and speed < self.speed
             if down:
                 if self.pins[side] is None:

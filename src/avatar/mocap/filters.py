@@ -1,8 +1,8 @@
 """The One Euro filter (Casiez, Roussel, Vogel, CHI 2012) on keypoint positions.
 
 A first-order low-pass whose cutoff rises with speed: still joints are smoothed hard (no
-jitter), fast ones barely (little lag). Per keypoint, with its speed ``v`` (m/s, itself
-low-passed at ``d_cutoff``)::
+jitter), fast ones barely (little lag). Per keypoint, with its speed ``v`` (m/s: the step
+between raw samples, as MediaPipe's implementation takes it, low-passed at ``d_cutoff``)::
 
     cutoff = min_cutoff + beta * |v|          (Hz)
     tau    = 1 / (2 pi cutoff)                (s)
@@ -70,6 +70,7 @@ class PointFilter:
     def __init__(self, count: int, params: OneEuro | None = None):
         self.params = params or OneEuro()
         self.x = np.full((count, 3), np.nan)
+        self.raw = np.full((count, 3), np.nan)
         self.dx = np.zeros((count, 3))
         self.t = np.full(count, -np.inf)
 
@@ -80,14 +81,16 @@ class PointFilter:
         seen = np.isfinite(points).all(axis=1)
         fresh = seen & ((t - self.t > p.reset_after) | ~np.isfinite(self.x).all(axis=1))
         self.x[fresh], self.dx[fresh], self.t[fresh] = points[fresh], 0.0, t
+        self.raw[fresh] = points[fresh]
         go = seen & ~fresh & (t > self.t)
         if np.any(go):
             dt = (t - self.t[go])[:, None]
-            raw = (points[go] - self.x[go]) / dt
+            raw = (points[go] - self.raw[go]) / dt
             self.dx[go] += _alpha(p.d_cutoff, dt) * (raw - self.dx[go])
             speed = np.linalg.norm(self.dx[go], axis=1, keepdims=True)
             a = _alpha(p.min_cutoff + p.beta * speed, dt)
             self.x[go] += a * (points[go] - self.x[go])
+            self.raw[go] = points[go]
             self.t[go] = t
         out = np.where(seen[:, None], self.x, np.nan)
         return out

@@ -346,7 +346,8 @@ class PoseSolver:
         upper, lower = f.p[mid] - f.p[st.origin], f.p[far] - f.p[mid]
         normal = rot.cross(upper, lower)
         bend = float(np.linalg.norm(normal)) / (
-            float(np.linalg.norm(upper) * np.linalg.norm(lower)) + 1e-12)
+            float(np.linalg.norm(upper) * np.linalg.norm(lower)) + 1e-12
+        )
         weight = min(max((bend - 0.05) / 0.15, 0.0), 1.0)  # sin of the bend: 3..11 degrees
         if weight == 0.0:
             return world

@@ -1,0 +1,235 @@
+"""Unity HumanBodyBones on Avatar rigs, and Unity's frame <-> Avatar's.
+
+Axes. Unity is left-handed, Y up, a character facing +Z with its right hand towards +X.
+Avatar is right-handed, Z up, the character facing -Y with its left hand towards +X. So a
+Unity vector (x, y, z) is Avatar's (-x, -z, y) (``M = [[-1,0,0],[0,0,-1],[0,1,0]]``,
+det -1: the handedness flips). A rotation R_u becomes M R_u M^T; as quaternions, Unity's
+(x, y, z, w) is Avatar's (w, x, z, -y): the axis maps as a pseudovector (-M a) and the
+angle keeps its value. ``tests/mocap/test_vmc.py`` checks both against the matrices.
+
+What VMC sends. Each ``/VMC/Ext/Bone/Pos`` carries a HumanBodyBones bone's
+``localPosition`` and ``localRotation`` on a normalised humanoid: in the T-pose every bone's
+frame is the model's frame (all local rotations identity), so a bone's world rotation,
+the product of its ancestors' local rotations, is its turn away from the T-pose (``D``).
+``/VMC/Ext/Root/Pos`` places the model (position, rotation) in the world.
+
+On an Avatar rig (``UnityRig``): each mapped bone's world rotation is ``D T`` with ``T``
+the bone's world rotation in the rig's own T-pose (``motion.poselib``'s t-pose: arms out
+straight); bones in between on the spine and neck share the turn of their mapped
+neighbours; other bones keep their T-pose relation to their parent. The hips go where
+the sender's hips are, scaled by the rig's leg length over the sender's (from its bone
+positions). The sender does the reverse with the same T-pose, so Avatar -> VMC -> Avatar
+is exact (float32 on the wire).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from dataclasses import dataclass
+from importlib import resources
+
+import numpy as np
+
+from avatar.motion import bonemap, geometry, poselib
+from avatar.rig import quaternion
+from avatar.rig.kinematics import rest_quaternions, world_pose
+from avatar.rig.skeleton import Skeleton
+
+M = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+"""Unity vector -> Avatar vector (``M @ v``); its inverse is its transpose."""
+
+
+@functools.cache
+def human_bones() -> tuple[tuple[str, str | None, str | None], ...]:
+    """(name, Unity parent, canonical role) for the 55 HumanBodyBones, parents first."""
+    text = (resources.files("avatar") / "data" / "mocap" / "unity_humanoid.json").read_text("utf-8")
+    return tuple((b[0], b[1], b[2]) for b in json.loads(text)["bones"])
+
+
+def to_avatar_vector(v: np.ndarray) -> np.ndarray:
+    """(..., 3) Unity positions -> Avatar's."""
+    v = np.asarray(v, dtype=np.float64)
+    return np.stack([-v[..., 0], -v[..., 2], v[..., 1]], axis=-1)
+
+
+def to_unity_vector(v: np.ndarray) -> np.ndarray:
+    """(..., 3) Avatar positions -> Unity's."""
+    v = np.asarray(v, dtype=np.float64)
+    return np.stack([-v[..., 0], v[..., 2], -v[..., 1]], axis=-1)
+
+
+def to_avatar_quaternion(q: np.ndarray) -> np.ndarray:
+    """(..., 4) Unity quaternions (x, y, z, w) -> Avatar's (w, x, y, z)."""
+    q = np.asarray(q, dtype=np.float64)
+    return np.stack([q[..., 3], q[..., 0], q[..., 2], -q[..., 1]], axis=-1)
+
+
+def to_unity_quaternion(q: np.ndarray) -> np.ndarray:
+    """(..., 4) Avatar quaternions (w, x, y, z) -> Unity's (x, y, z, w)."""
+    q = np.asarray(q, dtype=np.float64)
+    return np.stack([q[..., 1], -q[..., 3], q[..., 2], q[..., 0]], axis=-1)
+
+
+@dataclass(frozen=True)
+class UnityPose:
+    """One humanoid pose as VMC carries it (Unity's axes).
+
+    root: (position (3,), rotation (4,) xyzw) of the model.
+    bones: HumanBodyBones name -> (localPosition (3,), localRotation (4,) xyzw).
+    """
+
+    root: tuple[np.ndarray, np.ndarray]
+    bones: dict[str, tuple[np.ndarray, np.ndarray]]
+
+
+class UnityRig:
+    """HumanBodyBones on one Avatar rig: ``to_unity`` (send) and ``from_unity`` (receive)."""
+
+    def __init__(self, skeleton: Skeleton, bmap: bonemap.BoneMap | None = None):
+        self.skeleton = skeleton
+        bmap = bonemap.detect(skeleton) if bmap is None else bmap
+        self.names = [b[0] for b in human_bones()]
+        self.unity_parent = [self.names.index(p) if p else -1 for _, p, _ in human_bones()]
+        self.bone_of = self._map(skeleton, bmap)  # Unity index -> rig bone (-1: none)
+        tpose = poselib.built_in(skeleton, "t-pose")
+        t_rot, t_heads = world_pose(skeleton, tpose.rotations[0], tpose.translations[0])
+        self.t_rot, self.t_heads = t_rot, t_heads
+        self.rest_rot, self.local_rest = rest_quaternions(skeleton)
+        self.hips = bmap.bones["hips"]
+        self.source, self.shares = self._sources(skeleton, bmap)
+        above, j = [], int(skeleton.parents[self.hips])
+        while j >= 0:
+            above.append(j)
+            j = int(skeleton.parents[j])
+        self.above_hips = np.array(above, dtype=int)  # bones that stay at rest
+        self.leg = _leg(t_heads, bmap)
+
+    def _map(self, skeleton: Skeleton, bmap: bonemap.BoneMap) -> np.ndarray:
+        out = np.full(len(self.names), -1)
+        for u, (_, _, role) in enumerate(human_bones()):
+            if role and role in bmap.bones:
+                out[u] = bmap.bones[role]
+        chest = bmap.bones.get("chest")
+        if chest is not None and "spine" in bmap.bones:
+            chain = geometry.path(skeleton, bmap.bones["spine"], chest)
+            out[self.names.index("Chest")] = chain[len(chain) // 2] if len(chain) >= 3 else chest
+            if len(chain) >= 3:
+                out[self.names.index("UpperChest")] = chest
+            if len(chain) >= 2:
+                out[self.names.index("Spine")] = chain[0]
+        return out
+
+    def _sources(self, skeleton: Skeleton, bmap: bonemap.BoneMap):
+        """Per rig bone, the Unity bone whose turn it takes (mapped, or its parent's), and
+        the in-between spine/neck bones: (bone, lower Unity, upper Unity, fraction)."""
+        count = len(skeleton.names)
+        source = np.full(count, self.names.index("Hips"))
+        mapped = {int(b): u for u, b in enumerate(self.bone_of) if b >= 0}
+        for j in range(count):
+            p = skeleton.parents[j]
+            source[j] = mapped.get(j, source[p] if p >= 0 else source[j])
+        shares = []
+        for top in ("head",):
+            if top not in bmap.bones or "hips" not in bmap.bones:
+                continue
+            path = geometry.path(skeleton, bmap.bones["hips"], bmap.bones[top])
+            marks = [i for i, j in enumerate(path) if j in mapped]
+            for lo, hi in zip(marks, marks[1:], strict=False):
+                for i in range(lo + 1, hi):
+                    shares.append((path[i], mapped[path[lo]], mapped[path[hi]],
+                                   (i - lo) / (hi - lo)))  # fmt: skip
+        return source, shares
+
+    # -- receive ---------------------------------------------------------------------------
+
+    def from_unity(self, pose: UnityPose) -> tuple[np.ndarray, np.ndarray]:
+        """A VMC pose -> (J, 4) pose-bone rotations and (J, 3) locations on this rig."""
+        n = len(self.names)
+        local = np.zeros((n, 4))
+        local[:, 3] = 1.0
+        for name, (_, q) in pose.bones.items():
+            local[self.names.index(name)] = q
+        turn = np.empty((n, 4))  # D per Unity bone, Avatar's axes
+        root_q = to_avatar_quaternion(pose.root[1])
+        for u in range(n):  # parents precede children
+            p = self.unity_parent[u]
+            lq = to_avatar_quaternion(local[u])
+            turn[u] = quaternion.multiply(root_q if p < 0 else turn[p], lq)
+        d = turn[self.source]
+        for bone, lo, hi, f in self.shares:
+            d[bone] = quaternion.slerp(turn[lo], turn[hi], f)
+        world = quaternion.multiply(d, self.t_rot)
+        world[self.above_hips] = self.t_rot[self.above_hips]
+        rotations = self._locals(world)
+        translations = np.zeros((len(self.skeleton.names), 3))
+        hips = pose.bones.get("Hips")
+        if hips is not None:
+            rq = np.asarray(pose.root[1], dtype=np.float64)
+            pos = to_avatar_vector(pose.root[0]) + quaternion.rotate(
+                to_avatar_quaternion(rq), to_avatar_vector(hips[0])
+            )
+            pos = pos * self._scale(pose)
+            translations[self.hips] = quaternion.rotate(
+                quaternion.conjugate(self.rest_rot[self.hips]), pos - self.skeleton.heads[self.hips]
+            )
+        return rotations, translations
+
+    def _locals(self, world: np.ndarray) -> np.ndarray:
+        parents = self.skeleton.parents
+        has = parents >= 0
+        base = self.local_rest.copy()
+        base[has] = quaternion.multiply(world[parents[has]], self.local_rest[has])
+        out = quaternion.multiply(quaternion.conjugate(base), world)
+        return out * np.where(out[:, :1] < 0, -1.0, 1.0)
+
+    def _scale(self, pose: UnityPose) -> float:
+        parts = [pose.bones.get(n) for n in ("LeftLowerLeg", "LeftFoot")]
+        if any(p is None for p in parts):
+            return 1.0
+        leg = sum(float(np.linalg.norm(p[0])) for p in parts if p is not None)
+        return self.leg / leg if leg > 1e-3 else 1.0
+
+    # -- send ------------------------------------------------------------------------------
+
+    def to_unity(self, rotations: np.ndarray, translations: np.ndarray) -> UnityPose:
+        """(J, 4) pose-bone rotations and (J, 3) locations on this rig -> a VMC pose."""
+        world, heads = world_pose(self.skeleton, rotations[None], translations[None])
+        world, heads = world[0], heads[0]
+        n = len(self.names)
+        turn = np.empty((n, 4))
+        for u in range(n):
+            b, p = self.bone_of[u], self.unity_parent[u]
+            if b >= 0:
+                turn[u] = quaternion.multiply(world[b], quaternion.conjugate(self.t_rot[b]))
+            else:
+                turn[u] = (1.0, 0.0, 0.0, 0.0) if p < 0 else turn[p]
+        bones = {}
+        for u in range(n):
+            b, p = self.bone_of[u], self.unity_parent[u]
+            if b < 0:
+                continue
+            parent_turn = np.array([1.0, 0.0, 0.0, 0.0]) if p < 0 else turn[p]
+            local = quaternion.multiply(quaternion.conjugate(parent_turn), turn[u])
+            if p < 0:
+                position = to_unity_vector(heads[b])
+            else:
+                above = self._mapped_above(u)
+                ref = self.t_heads[self.bone_of[above]] if above >= 0 else np.zeros(3)
+                position = to_unity_vector(self.t_heads[b] - ref)
+            bones[self.names[u]] = (position, to_unity_quaternion(local))
+        return UnityPose((np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])), bones)
+
+    def _mapped_above(self, u: int) -> int:
+        p = self.unity_parent[u]
+        while p >= 0 and self.bone_of[p] < 0:
+            p = self.unity_parent[p]
+        return p
+
+
+def _leg(heads: np.ndarray, bmap: bonemap.BoneMap) -> float:
+    b = bmap.bones
+    if not all(r in b for r in ("thigh.L", "shin.L", "foot.L")):
+        return 1.0
+    return float(np.linalg.norm(heads[b["shin.L"]] - heads[b["thigh.L"]])
+                 + np.linalg.norm(heads[b["foot.L"]] - heads[b["shin.L"]]))  # fmt: skip
