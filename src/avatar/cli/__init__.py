@@ -11,8 +11,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from avatar.cli import clothes, create, dataset, info, motion, paths
-from avatar.cli import mocap
+from avatar.cli import clothes, create, dataset, info, mocap, motion, paths
 from avatar.errors import AvatarError
 
 
