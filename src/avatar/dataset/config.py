@@ -203,8 +203,7 @@ def loads(text: str, source: str = "<config>", **overrides: Any) -> Config:
     people = v.section("people", {"count", "spacing"})
     v.only_keys("", set(data), {"seed", "count", "render", "bodies", "clothes", "motion",
                                 "camera", "lights", "background", "people"})  # fmt: skip
-    resolution = overrides.get("resolution") or v.pair("render.resolution", render, (256, 256),
-                                                        int, 16, 8192)  # fmt: skip
+    resolution = overrides.get("resolution") or v.size("render.resolution", render)
     config = Config(
         seed=int(_given(overrides, "seed", v.integer("seed", data, 0, 0, 2**63 - 1))),
         count=int(_given(overrides, "count", v.integer("count", data, 100, 1, 10**9))),
@@ -357,6 +356,14 @@ class _Validator:
         if not (lo <= low <= high <= hi):
             raise self.fail(key, f"must satisfy {lo:g} <= low <= high <= {hi:g}, got {value!r}")
         return (low, high)
+
+    def size(self, key: str, table: Mapping[str, Any]) -> tuple[int, int]:
+        value = table.get(key.rpartition(".")[2], [256, 256])
+        ok = isinstance(value, list) and len(value) == 2 and all(
+            isinstance(x, int) and not isinstance(x, bool) and 16 <= x <= 8192 for x in value)
+        if not ok:
+            raise self.fail(key, f"must be [width, height], 16..8192 pixels, got {value!r}")
+        return int(value[0]), int(value[1])
 
     def choice(self, key: str, table: Mapping[str, Any], default: str, allowed) -> str:
         value = table.get(key.rpartition(".")[2], default)

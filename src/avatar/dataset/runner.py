@@ -56,9 +56,9 @@ def run(config: Config, out: str | os.PathLike[str], workers: int = 1, engine: s
     start = time.perf_counter()
     if todo:
         if engine == "ray":
-            from avatar.dataset import ray_engine  # type: ignore[attr-defined]
+            from avatar.dataset.ray_engine import render as ray_render
 
-            results = ray_engine.render(config, out, todo, workers)
+            results = ray_render(config, out, todo, workers)
         elif engine == "local":
             results = _local(config, out, todo, workers)
         else:

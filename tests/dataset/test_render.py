@@ -1,0 +1,225 @@
+"""A small dataset rendered for real (pip bpy, Cycles), its labels checked against the
+geometry they claim to describe, loaded by pycocotools, resumed after a kill."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.skipif(
+    importlib.util.find_spec("bpy") is None or importlib.util.find_spec("OpenEXR") is None
+    or importlib.util.find_spec("pycocotools") is None,
+    reason="needs bpy, OpenEXR and pycocotools (the dataset extra)",
+)  # fmt: skip
+
+CONFIG = """
+seed = 3
+count = 3
+[render]
+resolution = [96, 80]
+samples = 2
+recycle_every = 2
+[people]
+count = [1, 2]
+[motion]
+clips = ["walk"]
+pose_probability = 0.3
+poses = ["a-pose", "t-pose"]
+[camera]
+distance = [3.2, 4.0]
+focal_mm = [35.0, 45.0]
+[clothes]
+tops = ["tshirt", "hoodie"]
+bottoms = ["jeans", "shorts"]
+shoes = ["shoes"]
+hair = ["hair-short", "hair-long"]
+face = ["eyebrows"]
+"""
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory, model):
+    from avatar.dataset import config, runner
+
+    out = tmp_path_factory.mktemp("ds")
+    (out.parent / "ds.toml").write_text(CONFIG)
+    c = config.load(out.parent / "ds.toml")
+    report = runner.run(c, out / "set", workers=1, config_text=CONFIG)
+    assert report.rendered == 3 and not report.failed, report.failed
+    return c, out / "set"
+
+
+def _posed(c, index):
+    from avatar.dataset import people, sampling
+
+    return [people.pose_person(p) for p in sampling.sample(c, index).people]
+
+
+def _labels(folder: Path):
+    from PIL import Image
+
+    from avatar.io import exr
+
+    return (np.array(Image.open(folder / "instances.png")), np.array(Image.open(folder / "parts.png")),
+            exr.read(folder / "depth.exr")["Z"], json.loads((folder / "meta.json").read_text()))  # noqa: E501
+
+
+def test_folder_is_complete_and_validates(dataset):
+    from avatar.dataset import store
+
+    _, out = dataset
+    assert store.validate(out) == []
+    lines = (out / "manifest.jsonl").read_text().splitlines()
+    assert sorted(json.loads(line)["id"] for line in lines) == [0, 1, 2]
+    info = json.loads((out / "dataset.json").read_text())
+    assert info["parts"][0] == "none" and len(info["coco_keypoints"]) == 17
+
+
+def test_coco_file_loads_and_evaluates_perfectly_against_itself(dataset):
+    from pycocotools.coco import COCO
+    from pycocotools.cocoeval import COCOeval
+
+    _, out = dataset
+    gt = COCO(str(out / "coco.json"))
+    assert len(gt.getImgIds()) == 3 and len(gt.getAnnIds()) >= 3
+    for ann in gt.loadAnns(gt.getAnnIds()):
+        mask = gt.annToMask(ann)
+        assert mask.sum() == ann["area"]
+    dets = [dict(a, score=1.0) for a in gt.loadAnns(gt.getAnnIds())]
+    for kind in ("keypoints", "segm", "bbox"):
+        evaluation = COCOeval(gt, gt.loadRes(dets), kind)
+        evaluation.evaluate()
+        evaluation.accumulate()
+        evaluation.summarize()
+        assert evaluation.stats[0] == pytest.approx(1.0), kind
+
+
+def test_visible_keypoints_land_inside_their_persons_mask(dataset):
+    from avatar.dataset.annotate import person_of
+
+    _, out = dataset
+    hits = total = 0
+    for i in range(3):
+        instance, _, _, meta = _labels(out / "samples" / f"{i:08d}")
+        owner = person_of(instance)
+        h, w = instance.shape
+        for p, person in enumerate(meta["people"]):
+            for u, v, vis in person["keypoints_2d"]:
+                if vis == 2:
+                    total += 1
+                    r, c = int(round(v)), int(round(u))
+                    window = owner[max(r - 1, 0): r + 2, max(c - 1, 0): c + 2]
+                    hits += bool((window == p).any())
+    assert total > 20 and hits / total > 0.97, (hits, total)
+
+
+def test_depth_lands_on_the_posed_surfaces_and_ids_name_their_mesh(dataset):
+    """Every labelled pixel's depth, back-projected through K and world_to_camera, lies on
+    the surface of the mesh its instance id names (mm level)."""
+    from avatar.camera import unproject
+    from avatar.dataset.annotate import instance_id
+    from avatar.geometry import collision
+
+    c, out = dataset
+    checked = 0
+    for i in range(3):
+        folder = out / "samples" / f"{i:08d}"
+        instance, _, depth, meta = _labels(folder)
+        world = unproject(depth, np.array(meta["K"]), np.array(meta["world_to_camera"]))
+        for p, person in enumerate(_posed(c, i)):
+            items = [(instance_id(p, 0), person.parts[0])]
+            items += [(instance_id(p, k - 1), part) for k, part in enumerate(person.parts)
+                      if k >= 2]  # fmt: skip
+            for ident, part in items:
+                pixels = world[instance == ident]
+                if len(pixels) < 5:
+                    continue
+                mesh = part.mesh
+                body = collision.PosedBody(collision.body_surface(mesh.faces), mesh.vertices)
+                # many candidate triangles: hair cards cross each other densely
+                d = np.abs(body.query(pixels.astype(np.float32), k=48).distance)
+                assert np.median(d) < 0.0005 and np.mean(d < 0.003) > 0.97, (i, part.name)
+                checked += 1
+    assert checked >= 6
+
+
+def test_parts_label_skin_and_clothes_of_each_person(dataset):
+    _, out = dataset
+    for i in range(3):
+        instance, parts, _, _ = _labels(out / "samples" / f"{i:08d}")
+        person = instance > 0
+        assert np.all(parts[~person] == 0)
+        assert np.mean(parts[person] > 0) > 0.97
+        assert set(np.unique(parts[person])) <= set(range(1, 16))
+
+
+def test_killed_run_resumes_to_the_same_labels(dataset, tmp_path):
+    """SIGKILL the command mid-run, run it again: the set equals the clean run's (same
+    label bytes), with no duplicate or partial sample."""
+    c, clean = dataset
+    config_path = tmp_path / "ds.toml"
+    config_path.write_text(CONFIG)
+    out = tmp_path / "set"
+    cmd = [sys.executable, "-m", "avatar.cli", "dataset", "run", str(config_path), "-o", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)  # fmt: skip
+    deadline = time.time() + 240
+    while time.time() < deadline and proc.poll() is None:
+        manifest = out / "manifest.jsonl"
+        if manifest.exists() and manifest.read_text().count("\n") >= 1:
+            break
+        time.sleep(0.2)
+    os.killpg(proc.pid, signal.SIGKILL)  # the command and its worker, mid-sample
+    proc.wait()
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = (out / "manifest.jsonl").read_text().splitlines()
+    assert sorted(json.loads(line)["id"] for line in lines) == [0, 1, 2]
+    assert not list((out / "samples").glob(".tmp-*"))
+    for i in range(3):
+        for name in ("depth.exr", "normals.exr", "parts.png", "instances.png", "meta.json"):
+            a = (clean / "samples" / f"{i:08d}" / name).read_bytes()
+            b = (out / "samples" / f"{i:08d}" / name).read_bytes()
+            assert a == b, (i, name)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs Ray (the ray extra)")
+def test_ray_cluster_on_loopback_renders_the_same_samples(dataset, tmp_path):
+    """A real local Ray cluster (`ray start --head` on 127.0.0.1): the same label bytes as
+    the local engine."""
+    import shutil
+
+    _, clean = dataset
+    ray_bin = Path(sys.executable).parent / "ray"
+    env = dict(os.environ, RAY_ENABLE_UV_RUN_RUNTIME_ENV="0")
+    start = subprocess.run([str(ray_bin), "start", "--head", "--node-ip-address=127.0.0.1",
+                            "--port=0", "--num-cpus=1", "--include-dashboard=false",
+                            "--disable-usage-stats"], capture_output=True, text=True, env=env,
+                           timeout=180)  # fmt: skip
+    if start.returncode != 0:
+        pytest.skip(f"ray start failed here: {start.stderr[-300:]}")
+    try:
+        config_path = tmp_path / "ds.toml"
+        config_path.write_text(CONFIG)
+        out = tmp_path / "set"
+        run = subprocess.run([sys.executable, "-m", "avatar.cli", "dataset", "run",
+                              str(config_path), "-o", str(out), "-n", "2", "--engine", "ray"],
+                             capture_output=True, text=True, timeout=600,
+                             env=dict(env, RAY_ADDRESS="auto"))  # fmt: skip
+        assert run.returncode == 0, run.stderr[-2000:]
+    finally:
+        subprocess.run([str(ray_bin), "stop", "--force"], capture_output=True, timeout=120)
+    for i in range(2):
+        for name in ("depth.exr", "parts.png", "instances.png"):
+            assert (clean / "samples" / f"{i:08d}" / name).read_bytes() == \
+                (out / "samples" / f"{i:08d}" / name).read_bytes(), (i, name)  # fmt: skip
+    shutil.rmtree(out, ignore_errors=True)
