@@ -69,8 +69,10 @@ def _labels(folder: Path):
 
     from avatar.io import exr
 
-    return (np.array(Image.open(folder / "instances.png")), np.array(Image.open(folder / "parts.png")),
-            exr.read(folder / "depth.exr")["Z"], json.loads((folder / "meta.json").read_text()))  # noqa: E501
+    instance = np.array(Image.open(folder / "instances.png"))
+    parts = np.array(Image.open(folder / "parts.png"))
+    depth = exr.read(folder / "depth.exr")["Z"]
+    return instance, parts, depth, json.loads((folder / "meta.json").read_text())
 
 
 def test_folder_is_complete_and_validates(dataset):
