@@ -10,13 +10,16 @@ Spec: https://protocol.vmc.info/english (the performer -> marionette messages):
 
 Receivers listen on UDP 39539 by convention. Axes and handedness: ``avatar.mocap.unity``.
 
-Frames. A frame completes at ``/VMC/Ext/OK``, or at the end of a bundle that carried bone
-data without one; its bones are the latest value of every bone received so far (senders
-may send only what changed). Dropped and counted, never raised: undecodable datagrams
-("malformed"), messages with wrong argument types or counts, non-finite numbers or
-non-unit quaternions ("bad_message"), frames whose ``/VMC/Ext/T`` is not after the last
-accepted one ("out_of_order"), frames with more bone messages than a humanoid has
-("oversize"). Unknown bone names are ignored ("unknown_bone").
+Frames. A frame completes at the end of a bundle that carried an ``/VMC/Ext/OK`` or bone
+data (senders put ``/VMC/Ext/T`` after OK), or at an ``/VMC/Ext/OK`` datagram of its own;
+its bones are the latest value of every bone received so far (senders may send only what
+changed).
+
+Dropped and counted, never raised: undecodable datagrams ("malformed"), messages with wrong
+argument types or counts, non-finite numbers or non-unit quaternions ("bad_message"),
+frames whose ``/VMC/Ext/T`` is not after the last accepted one ("out_of_order"), frames
+with more bone messages than a humanoid has ("oversize"). Unknown bone names are ignored
+("unknown_bone").
 """
 
 from __future__ import annotations
@@ -106,21 +109,21 @@ class VmcAssembler:
         except Exception:  # python-osc raises several types on garbage; all mean malformed
             self.counters.drop("malformed")
             return []
-        out: list[Frame] = []
-        completed = False
-        for msg in messages:
-            frame = self._message(str(msg.address), list(msg.params), arrival)
-            if frame is not None:
-                out.append(frame)
-                completed = True
+        # In a bundle the frame completes at its end: senders put /VMC/Ext/T after OK.
         bundle = datagram[:8] == b"#bundle\x00"
-        if bundle and not completed and self.pending_count:
-            frame = self._complete(arrival)
-            if frame is not None:
-                out.append(frame)
+        out: list[Frame] = []
+        ok = False
+        for msg in messages:
+            if self._message(str(msg.address), list(msg.params)):
+                ok = True
+                if not bundle:
+                    out += self._complete(arrival)
+        if bundle and (ok or self.pending_count):
+            out += self._complete(arrival)
         return out
 
-    def _message(self, address: str, params: list, arrival: float) -> Frame | None:
+    def _message(self, address: str, params: list) -> bool:
+        """Take one message into the pending frame; True for /VMC/Ext/OK."""
         if address == "/VMC/Ext/Bone/Pos":
             parsed = _pose_args(params)
             if parsed is None:
@@ -149,21 +152,21 @@ class VmcAssembler:
             else:
                 self.blends[params[0]] = values[0]
         elif address == "/VMC/Ext/OK":
-            return self._complete(arrival)
-        return None
+            return True
+        return False
 
-    def _complete(self, arrival: float) -> Frame | None:
+    def _complete(self, arrival: float) -> list[Frame]:
         count, sent = self.pending_count, self.pending_time
         bones, root = self.pending_bones, self.pending_root
         self._reset_pending()
         if count > _MAX_BONE_MESSAGES:
             self.counters.drop("oversize")
-            return None
+            return []
         if not bones and root is None:
-            return None  # an OK alone: a heartbeat
+            return []  # an OK alone: a heartbeat
         if sent is not None and self.last_sent is not None and sent <= self.last_sent:
             self.counters.drop("out_of_order")
-            return None
+            return []
         if sent is not None:
             self.last_sent = sent
         self.bones.update(bones)
@@ -171,7 +174,7 @@ class VmcAssembler:
             self.root = root
         frame = Frame(UnityPose(self.root, dict(self.bones)), sent, arrival)
         self.counters.accept(frame)
-        return frame
+        return [frame]
 
 
 class VmcReceiver(Source):
