@@ -1,9 +1,9 @@
 """Morph weights over time -> an action on a mesh's shape keys (Blender 4.4+ slotted actions).
 
-The baked garment corrections (``avatar.clothes.bake``) are step functions: frame t's
-target is 1 at frame t and 0 elsewhere. Each weight column becomes one F-curve on its
-shape key's ``value`` with CONSTANT interpolation (glTF's STEP), keyed only where the value
-changes (2 or 3 keys a target, not one per frame), written as whole arrays with
+The baked garment corrections (``avatar.clothes.bake``) are a few correction shape keys a
+garment, driven by per-frame values (their weights at each frame, held until the next:
+glTF's STEP). Each weight column becomes one F-curve on its shape key's ``value`` with
+CONSTANT interpolation, keyed only where the value changes, written as whole arrays with
 ``foreach_set`` like ``avatar.blender.action``.
 """
 

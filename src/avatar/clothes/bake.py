@@ -1,14 +1,25 @@
-"""Bake per-frame garment resolves into morph targets, so exported animations do not clip.
+"""Bake per-frame garment resolves into a few morph targets, so exported animations do not clip.
 
 A glTF viewer skins a garment with plain linear blend skinning (LBS), which drives it into
 the body where the body bends; ``Outfit.frame(..., exact=True)`` pushes it back out. For
 every frame t this module takes the resolved vertices V_t and what the viewer will compute,
 L_t = LBS of the exported part mesh with the weights exactly as the file stores them
-(``gltf_weights.pack_weights``: at most 8 influences, renormalised), and turns the posed
-correction D_t = V_t - L_t into a bind-space morph delta. LBS is linear in the rest
+(``gltf_weights.pack_weights``: at most 8 (or 4) influences, renormalised), and turns the
+posed correction D_t = V_t - L_t into a bind-space delta. LBS is linear in the rest
 position: skin(p + d) = skin(p) + A d with A = sum_j w_j R_j, the blend of the skinning
-matrices' 3x3 parts, so d = A^-1 D_t. Frame t's target is switched on (weight 1) for that
-frame only; frames that need no correction get no target.
+matrices' 3x3 parts, so d_t = A^-1 D_t.
+
+Compact form. The per-frame deltas of one garment, stacked as X (T, 3U) over the U vertices
+that ever move, are nearly low-rank (the same folds at elbows, knees, hips recur), so each
+garment gets a small basis: the principal components of X (no centring: a frame without
+correction has weights 0), the smallest count k <= ``MAX_BASIS`` whose reconstruction
+(``project``: weights w_t = X_t B^T) leaves no vertex of any frame more than ``ERROR_BOUND``
+from its exact delta; past ``MAX_BASIS`` shapes the count grows further (to ``LIMIT``) only
+if the bound needs it. The file holds k morph targets ``correction_00``.. per garment and
+a (T, k) weights channel: it grows linearly with the clip (k weights a frame), not with its
+square. Because A is a blend of rotations (its norm is at most 1), a bind-space error e
+moves the played-back vertex by at most e: garments are never more than ``ERROR_BOUND``
+inside where the exact frame is outside.
 
     parts, weights = bake(human.body, human.outfit, animation, human.parts())
     gltf.write(path, parts, human.skeleton, {"walk": animation}, morph_weights={"walk": weights})
@@ -18,23 +29,28 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
+from functools import partial
 
 import numpy as np
 
 from avatar.body.shaped import Body
 from avatar.clothes.outfit import Outfit
 from avatar.errors import AvatarError
-from avatar.io.gltf_weights import pack_weights
+from avatar.io.gltf_weights import MAX_INFLUENCES, pack_weights
 from avatar.part import MeshPart
 from avatar.rig import kinematics, skinning
 from avatar.rig.skeleton import Animation
 
 log = logging.getLogger(__name__)
 
-TOLERANCE = 5e-5  # m; smaller corrections are left out (the target stays sparse)
+TOLERANCE = 5e-5  # m; smaller corrections are left out (the targets stay sparse)
 CHUNK = 256  # frames whose bone matrices are computed together
 SINGULAR = 1e-6  # |det A| below which a vertex's blended matrix is inverted by pseudo-inverse
+ERROR_BOUND = 5e-4  # m: worst distance of a played-back garment vertex from its exact frame
+MAX_BASIS = 16  # correction shapes a garment gets when they meet ERROR_BOUND (the usual case)
+LIMIT = 64  # most shapes a garment gets when ERROR_BOUND needs more than MAX_BASIS
+BASIS_PREFIX = "correction_"
 
 
 SkinOf = Callable[[MeshPart, int], skinning.SkinWeights]  # (part, joint count) -> its skin
@@ -47,43 +63,145 @@ def bake(
     parts: list[MeshPart],
     progress: bool = False,
     skin: SkinOf | None = None,
+    max_influences: int = MAX_INFLUENCES,
+    bound: float = ERROR_BOUND,
 ) -> tuple[list[MeshPart], dict[str, np.ndarray]]:
-    """Add one morph target per corrected frame to each garment part of ``parts``.
+    """Add each garment's correction basis (a few morph targets) to the garment parts.
 
     body: the shaped body; outfit: the garments fitted on it (``Human.outfit``).
     parts: the parts to export (``Human.parts(...)``): its last ``len(outfit)`` parts are
         the outfit's garments, as ``library.parts`` makes them.
     animation: (T frames) on ``body.skeleton``.
     progress: show a progress bar (tqdm) over the frames.
-    skin: the weights the player will skin with (default ``file_skin``, a glTF viewer's;
-        ``vertex_group_skin`` for Blender's Armature modifier).
-    Returns the parts (garments with extra morphs named ``frame_0007``, after any they
-    had; deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32
-    morph weights: 1 for frame t's own target at frame t, else 0.
+    skin: the weights the player will skin with (default ``file_skin`` with
+        ``max_influences``, a glTF viewer's; ``vertex_group_skin`` for Blender's Armature).
+    bound: the largest distance (m) a played-back vertex may be from its exact frame.
+    Returns the parts (garments with extra morphs ``correction_00``.. after any they had;
+    deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32 morph
+    weights (0 for the morphs they had before), for garments that need a correction.
     """
     garments = _garment_parts(parts, outfit)
     joints = len(body.skeleton.names)
-    skins = [(skin or file_skin)(p, joints) for p in garments]
-    corrections: list[dict[int, np.ndarray]] = [{} for _ in garments]
+    skin_of = skin or partial(file_skin, limit=max_influences)
+    skins = [skin_of(p, joints) for p in garments]
+    corrections = [Corrections(len(p.mesh.vertices), animation.frames) for p in garments]
     for t, posed, matrices in _frames(body, animation, progress):
         resolved = outfit.frame(posed, matrices, exact=True)
         for i, part in enumerate(garments):
             delta = bind_correction(part.mesh.vertices, skins[i], matrices, resolved[i])
             if delta is not None:
-                corrections[i][t] = delta
-    pairs = list(zip(garments, corrections, strict=True))
-    baked = [_with_targets(p, c, animation.frames) for p, c in pairs]
-    counts = ", ".join(f"{p.name} {len(c)}/{animation.frames}" for p, c in pairs)
-    log.info("garment corrections baked (frames with a target): %s", counts)
+                corrections[i].add(t, delta)
+    baked = [_with_basis(p, c, bound) for p, c in zip(garments, corrections, strict=True)]
     out = parts[: len(parts) - len(garments)] + [part for part, _ in baked]
     return out, {part.name: w for part, w in baked if w is not None}
 
 
-def file_skin(part: MeshPart, joints: int) -> skinning.SkinWeights:
-    """The part's skin weights as the glTF file stores them (what a viewer skins with)."""
+@dataclass
+class Corrections:
+    """One garment's per-frame bind-space deltas, stored sparsely as they are computed."""
+
+    vertices: int
+    frames: int
+    rows: dict[int, np.ndarray] = field(default_factory=dict)  # t -> (n,) moved vertices
+    deltas: dict[int, np.ndarray] = field(default_factory=dict)  # t -> (n, 3) float32
+
+    def add(self, t: int, delta: np.ndarray) -> None:
+        rows = np.flatnonzero(np.any(delta != 0, axis=1))
+        self.rows[t], self.deltas[t] = rows, np.asarray(delta[rows], dtype=np.float32)
+
+    def matrix(self) -> tuple[np.ndarray, np.ndarray]:
+        """(moved (U,) vertex indices, X (T, U, 3) float32 deltas of those vertices)."""
+        moved = np.unique(np.concatenate([np.zeros(0, np.int64), *self.rows.values()]))
+        x = np.zeros((self.frames, len(moved), 3), dtype=np.float32)
+        for t, rows in self.rows.items():
+            x[t, np.searchsorted(moved, rows)] = self.deltas[t]
+        return moved, x
+
+
+@dataclass(frozen=True)
+class Basis:
+    """A garment's compact correction: shapes (k, U, 3) over vertices ``moved`` (U,),
+    weights (T, k), and the worst per-vertex reconstruction error (m)."""
+
+    moved: np.ndarray
+    shapes: np.ndarray
+    weights: np.ndarray
+    error: float
+
+
+def fit_basis(x: np.ndarray, bound: float = ERROR_BOUND, limit: int = LIMIT) -> tuple[
+    np.ndarray, np.ndarray, float
+]:  # fmt: skip
+    """The fewest principal shapes of per-frame deltas that reproduce every frame within
+    ``bound``: x (T, U, 3) -> shapes (k, U, 3) float32 orthonormal (flattened), weights
+    (T, k) float32 (projections, so frames without correction get 0), worst error (m).
+
+    k is the smallest count meeting ``bound``, at most ``limit`` (then the error says how
+    far off it is).
+    """
+    frames = len(x)
+    flat = x.reshape(frames, -1)
+    if not flat.size or not np.any(flat):
+        return np.zeros((0,) + x.shape[1:], np.float32), np.zeros((frames, 0), np.float32), 0.0
+    directions = _principal_directions(flat, limit)  # (L, N) float64 orthonormal rows
+    weights = flat.astype(np.float64) @ directions.T  # (T, L)
+    residual = flat.astype(np.float64)
+    for k in range(len(directions) + 1):
+        error = float(np.sqrt((residual.reshape(frames, -1, 3) ** 2).sum(axis=2).max()))
+        if error <= bound or k == len(directions):
+            break
+        residual -= np.outer(weights[:, k], directions[k])
+    shapes = directions[:k].reshape((k,) + x.shape[1:]).astype(np.float32)
+    return shapes, weights[:, :k].astype(np.float32), error
+
+
+def _principal_directions(flat: np.ndarray, limit: int) -> np.ndarray:
+    """The top ``limit`` right singular vectors (L, N) of flat (T, N), through the smaller
+    of the two Gram matrices (T x T or N x N), in float64."""
+    a = flat.astype(np.float64)
+    frames, size = a.shape
+    if frames <= size:
+        values, vectors = np.linalg.eigh(a @ a.T)
+        order = np.argsort(values)[::-1][:limit]
+        keep = order[values[order] > values[order[0]] * 1e-12]
+        out = vectors[:, keep].T @ a
+        return out / np.linalg.norm(out, axis=1, keepdims=True)
+    values, vectors = np.linalg.eigh(a.T @ a)
+    order = np.argsort(values)[::-1][:limit]
+    keep = order[values[order] > values[order[0]] * 1e-12]
+    return vectors[:, keep].T
+
+
+def _with_basis(
+    part: MeshPart, corrections: Corrections, bound: float
+) -> tuple[MeshPart, np.ndarray | None]:
+    """The part with its correction shapes as morphs, and its (T, targets) weights."""
+    if not corrections.rows:
+        return part, None
+    moved, x = corrections.matrix()
+    shapes, weights, error = fit_basis(x, bound)
+    if len(shapes) > MAX_BASIS or error > bound:
+        log.warning("%s: %d correction shapes, worst error %.2f mm (bound %.2f mm)",
+                    part.name, len(shapes), error * 1e3, bound * 1e3)  # fmt: skip
+    log.info("%s: %d frames corrected -> %d shapes, worst error %.3f mm", part.name,
+             len(corrections.rows), len(shapes), error * 1e3)  # fmt: skip
+    morphs = dict(part.morphs)
+    before = len(morphs)
+    for k, shape in enumerate(shapes):
+        delta = np.zeros((corrections.vertices, 3), dtype=np.float32)
+        delta[moved] = shape
+        morphs[f"{BASIS_PREFIX}{k:02d}"] = delta
+    out = np.zeros((corrections.frames, len(morphs)), dtype=np.float32)
+    out[:, before:] = weights
+    return replace(part, morphs=morphs), out
+
+
+def file_skin(part: MeshPart, joints: int, limit: int = MAX_INFLUENCES) -> skinning.SkinWeights:
+    """The part's skin weights as the glTF file stores them (what a viewer skins with), at
+    most ``limit`` (4 or 8) influences a vertex."""
     if part.skin is None:
         raise AvatarError(f"garment part {part.name!r} has no skin weights")
-    idx, w = pack_weights(part.skin[0], part.skin[1], joints)
+    idx, w = pack_weights(part.skin[0], part.skin[1], joints, limit)
     return skinning.SkinWeights(idx.astype(np.int32), w)
 
 
@@ -172,19 +290,3 @@ def _frames(body: Body, animation: Animation, progress: bool):
                     matrices,
                 )
                 bar.update()
-
-
-def _with_targets(
-    part: MeshPart, corrections: dict[int, np.ndarray], frames: int
-) -> tuple[MeshPart, np.ndarray | None]:
-    """The part with one morph per corrected frame, and its (T, targets) weights."""
-    if not corrections:
-        return part, None
-    morphs = dict(part.morphs)
-    before = len(morphs)
-    for t, delta in corrections.items():
-        morphs[f"frame_{t:04d}"] = delta
-    weights = np.zeros((frames, len(morphs)), dtype=np.float32)
-    for k, t in enumerate(corrections):
-        weights[t, before + k] = 1.0
-    return replace(part, morphs=morphs), weights

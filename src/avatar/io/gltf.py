@@ -63,6 +63,7 @@ def write(
     embed: bool = False,
     vertex_ids: bool = True,
     generator: str = "Avatar",
+    max_influences: int = gltf_weights.MAX_INFLUENCES,
 ) -> None:
     """Write parts (and a skeleton with animations) as ``.glb`` or ``.gltf``.
 
@@ -74,7 +75,13 @@ def write(
         animation (e.g. per-frame garment corrections, ``avatar.clothes.bake``).
     embed: for ``.gltf``, put the buffer in a data URI instead of a side-car ``.bin``.
     vertex_ids: write ``_AVATAR_VERTEX`` so ``read`` can merge seam vertices back.
+    max_influences: joints per vertex, 8 (JOINTS_0 and JOINTS_1) or 4 (JOINTS_0 only, for
+        engines that read one set, e.g. three.js); the largest are kept, renormalised.
+    Parts named ``<name>_LOD1``, ``_LOD2``, ... are levels of detail of part ``<name>``
+    (the naming Unity and Unreal import as LOD groups): written like any part.
     """
+    if max_influences not in gltf_weights.INFLUENCE_LIMITS:
+        raise ValueError(f"max_influences is 4 or 8, not {max_influences}")
     path = Path(path)
     if path.suffix.lower() not in (".glb", ".gltf"):
         raise ValueError(f"glTF files end in .glb or .gltf, not {path.suffix!r}")
@@ -96,7 +103,8 @@ def write(
     materials.encode_all(part.material for part in parts)
     nodes = {}
     for part in parts:
-        nodes[part.name] = _add_part(gltf, packer, part, materials, skin_index, vertex_ids)
+        nodes[part.name] = _add_part(gltf, packer, part, materials, skin_index, vertex_ids,
+                                     max_influences)  # fmt: skip
     gltf_morphs.add_channels(gltf, packer, list(named), nodes, morph_weights or {})
     _save(gltf, bytes(packer.blob), path, embed)
 
@@ -153,7 +161,9 @@ def _triangulate(faces: np.ndarray, face_uvs: np.ndarray | None):
     return tris[keep], (None if uvs is None else uvs[keep])
 
 
-def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: bool) -> int:
+def _add_part(
+    gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: bool, max_influences: int
+) -> int:
     """One part -> one mesh with one primitive, and a node at the scene root (its index)."""
     mesh = part.mesh
     source, uv_index, triangles = split_vertices(mesh)
@@ -173,7 +183,8 @@ def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: b
             tangents = _tangents(positions, normals, uv, triangles)
             attributes.TANGENT = packer.accessor(tangents, acc.ARRAY_BUFFER)
     if part.skin is not None:
-        _add_skin_attributes(attributes, packer, part.skin, source, gltf_skin.joint_count(gltf))
+        _add_skin_attributes(attributes, packer, part.skin, source, gltf_skin.joint_count(gltf),
+                             max_influences)  # fmt: skip
     if vertex_ids:
         setattr(attributes, VERTEX_ID, packer.accessor(source.astype(np.float32), acc.ARRAY_BUFFER))
     index_type = np.uint16 if len(source) < 65535 else np.uint32
@@ -198,9 +209,10 @@ def _add_part(gltf, packer, part: MeshPart, materials, skin_index, vertex_ids: b
     return len(gltf.nodes) - 1
 
 
-def _add_skin_attributes(attributes, packer, skin, source, joint_count: int) -> None:
+def _add_skin_attributes(attributes, packer, skin, source, joint_count: int, limit: int) -> None:
     """JOINTS_0/WEIGHTS_0 (and _1 for more than four influences) for the glTF vertices."""
-    joints, weights = gltf_weights.pack_weights(skin[0][source], skin[1][source], joint_count)
+    joints, weights = gltf_weights.pack_weights(skin[0][source], skin[1][source], joint_count,
+                                                limit)  # fmt: skip
     for set_index in range(joints.shape[1] // 4):
         cols = slice(4 * set_index, 4 * set_index + 4)
         setattr(

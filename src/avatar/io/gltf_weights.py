@@ -8,27 +8,30 @@ from __future__ import annotations
 
 import numpy as np
 
-MAX_INFLUENCES = 8  # JOINTS_0 and JOINTS_1: what three.js, Babylon and Blender read
+MAX_INFLUENCES = 8  # JOINTS_0 and JOINTS_1: what Babylon, Blender and Unity read
+INFLUENCE_LIMITS = (4, 8)  # 4: JOINTS_0 only, what three.js and many engines skin with
 
 
 def pack_weights(
-    indices: np.ndarray, weights: np.ndarray, joint_count: int
+    indices: np.ndarray, weights: np.ndarray, joint_count: int, limit: int = MAX_INFLUENCES
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per-vertex influences -> glTF JOINTS/WEIGHTS columns (4 or 8 of them).
 
     indices, weights: (N, K) joint indices and weights, any K. Duplicate joints are merged,
-    negative weights dropped, the MAX_INFLUENCES largest kept and renormalised to sum 1;
+    negative weights dropped, the ``limit`` (4 or 8) largest kept and renormalised to sum 1;
     a vertex with no weight at all goes to joint 0 (the root). Unused slots get joint 0 and
     weight 0, as the spec requires.
     Returns joints (N, 4|8) uint8 (uint16 over 256 joints) and weights (N, 4|8) float32.
     """
+    if limit not in INFLUENCE_LIMITS:
+        raise ValueError(f"at most 4 or 8 influences per vertex, not {limit}")
     idx = np.asarray(indices, dtype=np.int64).copy()
     w = np.clip(np.asarray(weights, dtype=np.float64), 0.0, None).copy()
     if np.any((idx < 0) | (idx >= joint_count)) and np.any(w[(idx < 0) | (idx >= joint_count)]):
         raise ValueError(f"skin joint index out of range 0..{joint_count - 1}")
     w[(idx < 0) | (idx >= joint_count)] = 0.0
     _merge_duplicates(idx, w)
-    order = np.argsort(-w, axis=1, kind="stable")[:, :MAX_INFLUENCES]
+    order = np.argsort(-w, axis=1, kind="stable")[:, :limit]
     idx, w = np.take_along_axis(idx, order, 1), np.take_along_axis(w, order, 1)
     empty = w.sum(axis=1) <= 0
     w[empty, 0], idx[empty, 0] = 1.0, 0

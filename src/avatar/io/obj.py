@@ -1,21 +1,28 @@
-"""Wavefront OBJ read/write (positions, UVs, polygon faces, groups).
+"""Wavefront OBJ read/write (positions, UVs, polygon faces, groups) and its ``.mtl``.
 
-Spec: https://paulbourke.net/dataformats/obj/ . Avatar reads the subset MakeHuman writes:
-``v``, ``vt``, ``f`` (v, v/vt, v/vt/vn, v//vn), ``g``/``o`` groups; other statements are
-ignored. Coordinates are returned as stored; unit/axis conversion is the caller's choice
-through ``axes``.
+Spec: https://paulbourke.net/dataformats/obj/ (and the MTL spec beside it). Avatar reads the
+subset MakeHuman writes: ``v``, ``vt``, ``f`` (v, v/vt, v/vt/vn, v//vn), ``g``/``o`` groups;
+other statements are ignored. Coordinates are returned as stored; unit/axis conversion is
+the caller's choice through ``axes``. ``write_parts`` writes a whole character: one ``o``
+object per part with its ``usemtl`` material, a ``.mtl`` beside it and each texture as a PNG
+(``map_Kd`` colour, ``map_Bump`` normal map, ``map_Pr`` roughness: the PBR extension
+Blender's importer reads), all committed together (``atomic.write_all``).
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from avatar.errors import FormatError
-from avatar.io import atomic
+from avatar.io import atomic, png
+from avatar.material import Material
 from avatar.mesh import Mesh
+from avatar.part import MeshPart
 
 MAKEHUMAN = "makehuman"  # Y-up decimetres -> Avatar's Z-up metres
 
@@ -180,3 +187,127 @@ def _unpad(face: np.ndarray) -> list[int]:
 def write(path: str | os.PathLike[str], mesh: Mesh, axes: str | None = None) -> None:
     """Write a mesh as OBJ (atomically: a temporary file renamed into place)."""
     atomic.write_text(path, dumps(mesh, axes, name=Path(path).stem))
+
+
+# ---------------------------------------------------------------------------- characters
+
+
+def write_parts(path: str | os.PathLike[str], parts: Sequence[MeshPart]) -> list[Path]:
+    """Write parts as one OBJ (an ``o`` object each, in order), its ``.mtl`` and textures.
+
+    Textures are PNG files beside the OBJ named ``<stem>_<material>_<map>.png``. Every file
+    is written to a temporary name and renamed into place only when all were written.
+    Returns the paths written (OBJ first, then the ``.mtl``, then textures).
+    """
+    path = Path(path)
+    mtl = path.with_suffix(".mtl")
+    names = _material_names([p.material for p in parts])
+    textures: dict[Path, np.ndarray] = {}
+    library = []
+    for material, name in names.values():
+        maps = {kind: path.with_name(f"{path.stem}_{_safe(name)}_{kind}.png")
+                for kind in material.textures()}  # fmt: skip
+        textures.update({maps[k]: image for k, image in material.textures().items()})
+        library.append(_mtl_entry(material, name, {k: p.name for k, p in maps.items()}))
+    body = _objects(parts, names, mtl.name)
+    materials = "\n".join(library)
+    writers: dict[atomic.StrPath, Callable[[Path], object]] = {
+        path: lambda tmp: tmp.write_text(body, encoding="utf-8"),
+        mtl: lambda tmp: tmp.write_text(materials, encoding="utf-8"),
+    }
+    for file, image in textures.items():
+        writers[file] = partial(_write_png, image=image)
+    atomic.write_all(writers)
+    return [Path(p) for p in writers]
+
+
+def _write_png(tmp: Path, image: np.ndarray) -> None:
+    tmp.write_bytes(png.encode(image))
+
+
+def _material_names(materials: Sequence[Material | None]) -> dict[int, tuple[Material, str]]:
+    """id(material) -> (material, a name unique in the file), in first-use order."""
+    out: dict[int, tuple[Material, str]] = {}
+    taken: set[str] = set()
+    for m in [m or DEFAULT_MATERIAL for m in materials]:
+        if id(m) in out:
+            continue
+        name, i = _safe(m.name) or "material", 1
+        while name in taken:
+            name, i = f"{_safe(m.name)}.{i:03d}", i + 1
+        taken.add(name)
+        out[id(m)] = (m, name)
+    return out
+
+
+DEFAULT_MATERIAL = Material("default")
+TEXTURE_KEYS = {"base_color_texture": "map_Kd", "normal_texture": "map_Bump",
+                "roughness_texture": "map_Pr"}  # fmt: skip
+
+
+def _safe(name: str) -> str:
+    """A name usable in MTL statements and file names (no spaces or separators)."""
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
+
+
+def _mtl_entry(m: Material, name: str, maps: dict[str, str]) -> str:
+    """One ``newmtl`` block: colour (Kd), opacity (d), roughness (Pr), metallic (Pm), maps."""
+    r, g, b, a = m.base_color
+    lines = [f"newmtl {name}", f"Kd {r:.6f} {g:.6f} {b:.6f}", "Ka 0 0 0", "Ks 0.5 0.5 0.5",
+             f"Ns {max(0.0, (1.0 - m.roughness)) * 1000:.1f}", f"d {a:.6f}", "illum 2",
+             f"Pr {m.roughness:.6f}", f"Pm {m.metallic:.6f}"]  # fmt: skip
+    for field, statement in TEXTURE_KEYS.items():
+        if field in maps:
+            scale = f"-bm {m.normal_scale:g} " if field == "normal_texture" else ""
+            lines.append(f"{statement} {scale}{maps[field]}")
+    return "\n".join(lines) + "\n"
+
+
+def _objects(parts: Sequence[MeshPart], names: dict[int, tuple[Material, str]], mtl: str) -> str:
+    """The OBJ text: ``mtllib``, then each part's vertices, UVs, material and faces."""
+    lines = ["# written by avatar", f"mtllib {mtl}"]
+    v_base = t_base = 0
+    for part in parts:
+        mesh = part.mesh
+        lines.append(f"o {_safe(part.name)}")
+        lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in np.asarray(mesh.vertices)]
+        has_uv = mesh.uvs is not None and mesh.face_uvs is not None
+        if has_uv:
+            lines += [f"vt {u:.6f} {w:.6f}" for u, w in mesh.uvs]  # type: ignore[union-attr]
+        lines.append(f"usemtl {names[id(part.material or DEFAULT_MATERIAL)][1]}")
+        for i, face in enumerate(mesh.faces):
+            f = _unpad(face)
+            if has_uv:
+                t = mesh.face_uvs[i][: len(f)]  # type: ignore[index]
+                lines.append("f " + " ".join(f"{a + 1 + v_base}/{c + 1 + t_base}"
+                                             for a, c in zip(f, t, strict=True)))  # fmt: skip
+            else:
+                lines.append("f " + " ".join(str(a + 1 + v_base) for a in f))
+        v_base += len(mesh.vertices)
+        t_base += len(mesh.uvs) if has_uv else 0  # type: ignore[arg-type]
+    return "\n".join(lines) + "\n"
+
+
+def read_mtl(path: str | os.PathLike[str]) -> dict[str, dict[str, str]]:
+    """A ``.mtl`` file as material name -> statement -> the rest of its line.
+
+    Raises FormatError naming the line for a statement before any ``newmtl``.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise FormatError(path, 0, f"cannot read: {exc.strerror}") from None
+    out: dict[str, dict[str, str]] = {}
+    current: dict[str, str] | None = None
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        words = raw.split(maxsplit=1)
+        if not words or words[0].startswith("#"):
+            continue
+        rest = words[1].strip() if len(words) > 1 else ""
+        if words[0] == "newmtl":
+            current = out.setdefault(rest, {})
+        elif current is None:
+            raise FormatError(path, lineno, f"{words[0]!r} before any 'newmtl'")
+        else:
+            current[words[0]] = rest
+    return out
