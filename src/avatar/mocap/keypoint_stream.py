@@ -118,6 +118,8 @@ class KeypointReceiver(Source):
     def __init__(self, keypoints: KeypointSet, host: str = "0.0.0.0", port: int = DEFAULT_PORT):
         super().__init__()
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        # room for a second of frames while the thread waits for the interpreter
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
         try:
             self.sock.bind((host, port))
         except OSError as exc:
