@@ -4,6 +4,10 @@ An extension for Blender 4.2+ (blender_manifest.toml) that also loads as a legac
 (bl_info) in older Blenders, e.g. 3.4 for the UI smoke test. The ``avatar`` library is
 imported lazily by the operators, so the panels register even when it is missing and say
 how to install it.
+
+For scripts: ``bpy.ops.avatar.create_human()`` adds a human (hair, brows, lashes) and makes
+it active; ``obj.avatar.weight = 0.8`` (any body parameter, on the character's root object)
+changes it live; ``bpy.ops.avatar.wear(name="tshirt")`` dresses the active character.
 """
 
 from __future__ import annotations
@@ -33,27 +37,16 @@ _add_library_path()
 
 import bpy  # noqa: E402
 
-from . import operators, panels, properties  # noqa: E402
+from . import operators, panels, properties, thumbnails  # noqa: E402
 
 CLASSES = (
-    properties.AvatarTarget,
+    properties.AvatarModifier,
+    properties.AvatarCharacter,
     properties.AvatarGarment,
     properties.AvatarSettings,
     properties.AvatarPreferences,
-    operators.AVATAR_OT_create_human,
-    operators.AVATAR_OT_update_human,
-    operators.AVATAR_OT_load_recipe,
-    operators.AVATAR_OT_add_target,
-    operators.AVATAR_OT_remove_target,
-    operators.AVATAR_OT_refresh_library,
-    operators.AVATAR_OT_wear,
-    operators.AVATAR_OT_take_off,
-    operators.AVATAR_OT_bind_garment,
-    operators.AVATAR_OT_apply_motion,
-    panels.AVATAR_UL_garments,
-    panels.AVATAR_PT_body,
-    panels.AVATAR_PT_dress,
-    panels.AVATAR_PT_motion,
+    *operators.CLASSES,
+    *panels.CLASSES,
 )
 
 
@@ -61,9 +54,12 @@ def register() -> None:
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Scene.avatar = bpy.props.PointerProperty(type=properties.AvatarSettings)
+    bpy.types.Object.avatar = bpy.props.PointerProperty(type=properties.AvatarCharacter)
 
 
 def unregister() -> None:
+    thumbnails.release()
+    del bpy.types.Object.avatar
     del bpy.types.Scene.avatar
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

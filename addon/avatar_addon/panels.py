@@ -1,8 +1,16 @@
-"""Sidebar panels (View3D > Sidebar > Avatar): Body, Dress, Motion."""
+"""Sidebar panels (View3D > Sidebar > Avatar): Body, Dress, Motion.
+
+The Body panel shows the active character's own properties (``object.avatar``): moving a
+slider changes that character at once. With no character active it offers Create.
+"""
+
+import json
 
 import bpy
 
-from .properties import ATTRIBUTES, MACROS
+from . import catalogue, thumbnails
+from .operators import root_of
+from .properties import ATTRIBUTES, MACROS, RACES
 
 
 class _AvatarPanel:
@@ -18,41 +26,108 @@ class AVATAR_PT_body(_AvatarPanel, bpy.types.Panel):
     def draw(self, context):
         settings = context.scene.avatar
         layout = self.layout
-        column = layout.column(align=True)
-        for name in MACROS:
-            column.prop(settings, name, slider=True)
-        layout.label(text="Attributes")
-        column = layout.column(align=True)
-        for name in ATTRIBUTES:
-            column.prop(settings, f"pca_{name}", slider=True)
-        self._draw_targets(layout, settings)
-        layout.prop(settings, "rig")
         row = layout.row(align=True)
         row.scale_y = 1.4
         row.operator("avatar.create_human", icon="OUTLINER_OB_ARMATURE")
-        row.operator("avatar.update_human", icon="FILE_REFRESH")
-        layout.operator("avatar.load_recipe", icon="IMPORT")
-
-    @staticmethod
-    def _draw_targets(layout, settings):
-        layout.label(text="Local targets")
         row = layout.row(align=True)
-        row.prop(settings, "target_search", text="", icon="VIEWZOOM")
-        row.operator("avatar.add_target", text="", icon="ADD")
+        row.prop(settings, "rig", text="")
+        row.prop(settings, "rigged", text="", icon="ARMATURE_DATA")
+        row.prop(settings, "default_look", text="", icon="USER")
+        root = root_of(context.object)
+        if root is None:
+            layout.label(text="Select a character to edit it", icon="INFO")
+            layout.operator("avatar.import_mhm", icon="IMPORT")
+            return
+        props = root.avatar
+        layout.label(text=root.name, icon="OUTLINER_OB_ARMATURE")
+        if "avatar_error" in root.keys():
+            layout.label(text=root["avatar_error"], icon="ERROR")
         column = layout.column(align=True)
-        for target in settings.targets:
-            row = column.row(align=True)
-            row.prop(target, "value", text=target.name, slider=True)
-            row.operator("avatar.remove_target", text="", icon="X").name = target.name
+        for name in MACROS:
+            column.prop(props, name, slider=True)
+        box = layout.box()
+        box.label(text="Ethnicity (sums to 1)")
+        column = box.column(align=True)
+        for name in RACES:
+            column.prop(props, name, slider=True)
+        layout.label(text="Attributes (standard deviations)")
+        column = layout.column(align=True)
+        for name in ATTRIBUTES:
+            column.prop(props, f"pca_{name}", slider=True)
+        layout.prop(props, "rig")
+        _draw_measurements(layout, props, settings)
+        _draw_locals(layout, props, settings)
+        _draw_expressions(layout, props, settings)
+        _draw_body_tools(layout, settings)
 
 
-class AVATAR_UL_garments(bpy.types.UIList):
-    bl_idname = "AVATAR_UL_garments"
+def _draw_measurements(layout, props, settings):
+    box = layout.box()
+    box.label(text="Measurements (cm)")
+    grid = box.grid_flow(columns=2, align=True)
+    for name in ("height", "chest", "waist", "hips"):
+        grid.label(text=f"{name.title()}: {getattr(props, f'measured_{name}'):.1f}")
+    column = box.column(align=True)
+    for name in ("height", "chest", "waist", "hips"):
+        column.prop(settings, f"target_{name}")
+    box.operator("avatar.fit_measurements", icon="DRIVER_DISTANCE")
 
-    def draw_item(self, context, layout, data, item, icon, active_data, active_prop, index=0):
-        row = layout.row()
-        row.label(text=item.name, icon="MOD_CLOTH")
-        row.label(text=item.category)
+
+def _draw_locals(layout, props, settings):
+    box = layout.box()
+    icon = "TRIA_DOWN" if settings.show_locals else "TRIA_RIGHT"
+    box.prop(settings, "show_locals", icon=icon, emboss=False)
+    if not settings.show_locals:
+        return
+    box.prop(settings, "modifier_search", text="", icon="VIEWZOOM")
+    text = settings.modifier_search.strip().lower()
+    items = [m for m in props.modifiers if m.group != "expression"]
+    if text:
+        column = box.column(align=True)
+        for m in [m for m in items if text in m.name.lower()][:60]:
+            column.prop(m, "value", text=m.name, slider=True)
+        return
+    open_groups = set(settings.expanded.split(","))
+    for group in catalogue.groups():
+        row = box.row()
+        opened = group in open_groups
+        op = row.operator("avatar.toggle_group", text=group.title(), emboss=False,
+                          icon="TRIA_DOWN" if opened else "TRIA_RIGHT")  # fmt: skip
+        op.group = group
+        if opened:
+            column = box.column(align=True)
+            for m in items:
+                if m.group == group:
+                    column.prop(m, "value", text=m.label, slider=True)
+
+
+def _draw_expressions(layout, props, settings):
+    box = layout.box()
+    icon = "TRIA_DOWN" if settings.show_expressions else "TRIA_RIGHT"
+    box.prop(settings, "show_expressions", icon=icon, emboss=False)
+    if settings.show_expressions:
+        column = box.column(align=True)
+        for m in props.modifiers:
+            if m.group == "expression":
+                column.prop(m, "value", text=m.label, slider=True)
+
+
+def _draw_body_tools(layout, settings):
+    box = layout.box()
+    row = box.row(align=True)
+    row.prop(settings, "preset", text="")
+    row.operator("avatar.apply_preset", text="", icon="CHECKMARK")
+    row.operator("avatar.save_preset", text="", icon="ADD")
+    row = box.row(align=True)
+    row.prop(settings, "seed")
+    row.prop(settings, "realistic", text="", icon="USER")
+    row.operator("avatar.randomise", text="", icon="FILE_REFRESH")
+    row = box.row(align=True)
+    row.operator("avatar.reset_body", icon="LOOP_BACK")
+    row.operator("avatar.settle", icon="CHECKMARK")
+    row = box.row(align=True)
+    row.operator("avatar.import_mhm", icon="IMPORT")
+    row.operator("avatar.export_mhm", icon="EXPORT")
 
 
 class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
@@ -62,12 +137,31 @@ class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
     def draw(self, context):
         settings = context.scene.avatar
         layout = self.layout
-        layout.template_list("AVATAR_UL_garments", "", settings, "garments",
-                             settings, "garment_index", rows=5)  # fmt: skip
+        if not len(settings.garments):
+            layout.operator("avatar.refresh_library", icon="FILE_REFRESH", text="Load Library")
+            return
         row = layout.row(align=True)
-        row.operator("avatar.refresh_library", icon="FILE_REFRESH")
-        row.operator("avatar.wear", icon="ADD")
-        row.operator("avatar.take_off", icon="REMOVE")
+        row.prop(settings, "category", text="")
+        row.prop(settings, "garment_search", text="", icon="VIEWZOOM")
+        row.operator("avatar.refresh_library", text="", icon="FILE_REFRESH")
+        root = root_of(context.object)
+        worn = set(json.loads(root["avatar_recipe"]).get("clothes") or []) if root else set()
+        text = settings.garment_search.strip().lower()
+        grid = layout.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
+        for item in settings.garments:
+            if settings.category not in ("ALL", "", item.category):
+                continue
+            if text and text not in f"{item.name} {item.category}".lower():
+                continue
+            cell = grid.column(align=True)
+            icon = thumbnails.icon(item.entry, item.thumbnail)
+            if icon:
+                cell.template_icon(icon_value=icon, scale=3.0)
+            op = cell.operator("avatar.toggle_garment", text=item.name,
+                               depress=item.entry in worn,
+                               icon="CHECKMARK" if item.entry in worn else "NONE")  # fmt: skip
+            op.name = item.entry
+            cell.enabled = root is not None
         layout.operator("avatar.bind_garment", icon="MOD_CLOTH")
 
 
@@ -85,3 +179,13 @@ class AVATAR_PT_motion(_AvatarPanel, bpy.types.Panel):
         layout.prop(settings, "fps")
         layout.prop(settings, "in_place")
         layout.operator("avatar.apply_motion", icon="PLAY")
+        root = root_of(context.object)
+        report = root.get("avatar_motion_report") if root is not None else None
+        if report:
+            box = layout.box()
+            box.label(text="Retarget report", icon="INFO")
+            for line in str(report).splitlines()[:14]:
+                box.label(text=line)
+
+
+CLASSES = (AVATAR_PT_body, AVATAR_PT_dress, AVATAR_PT_motion)

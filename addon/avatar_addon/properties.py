@@ -1,7 +1,12 @@
-"""Scene settings behind the panels, and how they become a recipe.
+"""The add-on's properties: a character's body on its own root object, the panels' options
+on the scene.
 
-Property names equal the library's parameter names (``gender``, ``pca/belly`` as
-``pca_belly``), so ``body_params`` is a plain mapping with no per-slider code.
+``Object.avatar`` (``AvatarCharacter``) holds one character's parameters as float
+properties named after the library's (``gender``, ``cupsize``, ``pca/belly`` as
+``pca_belly``), and its local modifiers and face units as a list of (name, value).
+Setting any of them, from a slider or from Python, updates that character live
+(``live.apply_params``). The recipe JSON on the object stays the source of truth for
+files; these properties mirror it (``sync_from_recipe``).
 """
 
 import bpy
@@ -14,54 +19,134 @@ from bpy.props import (
     StringProperty,
 )
 
-from . import catalogue
+from . import live
 
-MACROS = ("gender", "age", "muscle", "weight", "height", "proportions")
+MACROS = ("gender", "age", "muscle", "weight", "height", "proportions", "cupsize", "firmness")
+RACES = ("african", "asian", "caucasian")
 ATTRIBUTES = ("breast", "shoulders_fat", "limbs_fat", "hips_fat", "weight", "strength", "belly")
 RIGS = ("default", "default_no_toes", "game_engine", "game_engine_with_breast", "cmu_mb", "mixamo")
+MACRO_HELP = {
+    "gender": "0 female, 1 male",
+    "age": "0 = 1 year, 0.1875 = 11, 0.5 = 25, 1 = 90 years",
+    "cupsize": "Breast size",
+    "firmness": "Breast firmness",
+    "proportions": "Body proportions, uncommon to ideal",
+}
 
 
-def _macro(name: str):
-    return FloatProperty(name=name.title(), min=0.0, max=1.0, default=0.5, subtype="FACTOR")
+def _changed(self, context):
+    live.apply_params(self.id_data)
 
 
-def _attribute(name: str):
+def _race_changed(name):
+    def update(self, context):
+        live.normalise_races(self, name)
+        live.apply_params(self.id_data)
+
+    return update
+
+
+def _macro(name, update=_changed, default=0.5):
+    return FloatProperty(name=name.title(), min=0.0, max=1.0, default=default, subtype="FACTOR",
+                         description=MACRO_HELP.get(name, name.title()), update=update)  # fmt: skip
+
+
+def _attribute(name):
     label = name.replace("_", " ").capitalize()
     about = f"Semantic attribute '{name}' in standard deviations"
-    return FloatProperty(name=label, min=-3.0, max=3.0, default=0.0, description=about)
+    return FloatProperty(name=label, min=-3.0, max=3.0, default=0.0, description=about,
+                         update=_changed)  # fmt: skip
 
 
-class AvatarTarget(bpy.types.PropertyGroup):
-    """A local target (MakeHuman modifier) the user added, with its value."""
+def _rig_changed(self, context):
+    live.change_rig(self.id_data, self.rig)
+
+
+class AvatarModifier(bpy.types.PropertyGroup):
+    """A local modifier (MakeHuman name) or face unit (``expression/...``) and its value."""
 
     name: StringProperty(name="Modifier")
-    value: FloatProperty(name="Value", min=-1.0, max=1.0, default=0.0)
+    label: StringProperty(name="Label")
+    group: StringProperty(name="Group")
+    minimum: FloatProperty(default=-1.0)
+    value: FloatProperty(name="Value", min=-1.0, max=1.0, default=0.0, update=_changed)
+
+
+class AvatarCharacter(bpy.types.PropertyGroup):
+    """One character's body (``object.avatar``); setting a value updates it live."""
+
+    __annotations__ = {
+        **{m: _macro(m) for m in MACROS},
+        **{r: _macro(r, _race_changed(r), 1 / 3) for r in RACES},
+        **{f"pca_{a}": _attribute(a) for a in ATTRIBUTES},
+        "modifiers": CollectionProperty(type=AvatarModifier),
+        "rig": EnumProperty(name="Rig", update=_rig_changed,
+                            items=[(r, r.replace("_", " ").title(), "") for r in RIGS]),
+        # The body's measurements (cm), refreshed when the character settles.
+        "measured_height": FloatProperty(name="Height", subtype="NONE", precision=1),
+        "measured_chest": FloatProperty(name="Chest", precision=1),
+        "measured_waist": FloatProperty(name="Waist", precision=1),
+        "measured_hips": FloatProperty(name="Hips", precision=1),
+    }  # fmt: skip
+
+    def params(self) -> dict:
+        """The library parameters these properties set (every macro and attribute, the
+        modifiers and face units that are not zero)."""
+        out = {m: float(getattr(self, m)) for m in (*MACROS, *RACES)}
+        out.update({f"pca/{a}": float(getattr(self, f"pca_{a}")) for a in ATTRIBUTES})
+        out.update({m.name: float(m.value) for m in self.modifiers if m.value != 0.0})
+        return out
 
 
 class AvatarGarment(bpy.types.PropertyGroup):
-    """One entry of the clothes library list."""
+    """One entry of the clothes library (the Dress panel's grid)."""
 
     name: StringProperty(name="Garment")
     category: StringProperty(name="Category")
     entry: StringProperty(name="Recipe entry", description="Built-in name or .mhclo path")
+    thumbnail: StringProperty(name="Thumbnail", subtype="FILE_PATH")
 
 
-def _search_targets(self, context, text: str):
+def _search_targets(self, context, text):
+    from . import catalogue
+
     return [n for n in catalogue.local_targets() if text.lower() in n.lower()][:200]
 
 
+def _categories(self, context):
+    from . import catalogue
+
+    cats = sorted({g.category for g in context.scene.avatar.garments if g.category})
+    return catalogue.enum_items(["ALL", *cats])
+
+
+def _presets(self, context):
+    from . import presets
+
+    return [(n, n.replace("_", " ").title(), "") for n in presets.names()] or [("", "", "")]
+
+
 class AvatarSettings(bpy.types.PropertyGroup):
-    """Everything the Avatar panels edit (``scene.avatar``)."""
+    """The panels' options (``scene.avatar``): what Create makes, the Dress panel's library
+    and filters, the Motion panel's clip, measurement targets, randomise, presets."""
 
     __annotations__ = {
-        **{m: _macro(m) for m in MACROS},
-        **{f"pca_{a}": _attribute(a) for a in ATTRIBUTES},
-        "target_search": StringProperty(name="Local target", search=_search_targets,
-                                        description="MakeHuman modifier to add as a slider"),
-        "targets": CollectionProperty(type=AvatarTarget),
         "rig": EnumProperty(name="Rig", items=[(r, r.replace("_", " ").title(), "") for r in RIGS]),
+        "rigged": BoolProperty(name="Rigged", default=True,
+                               description="Make an armature (off: a bare body mesh)"),
+        "default_look": BoolProperty(name="Hair, brows, lashes", default=True,
+                                     description="A new human wears short hair, brows, lashes"),
+        "modifier_search": StringProperty(name="Search", options={"TEXTEDIT_UPDATE"},
+                                          description="Show the local modifiers matching this"),
+        "expanded": StringProperty(name="Open groups", default=""),
+        "show_expressions": BoolProperty(name="Expressions", default=False),
+        "show_locals": BoolProperty(name="Local modifiers", default=False),
+        # Kept for scripts of earlier versions: a local target to add by name.
+        "target_search": StringProperty(name="Local target", search=_search_targets),
         "garments": CollectionProperty(type=AvatarGarment),
         "garment_index": IntProperty(default=0),
+        "garment_search": StringProperty(name="Search", options={"TEXTEDIT_UPDATE"}),
+        "category": EnumProperty(name="Category", items=_categories),
         "bvh_path": StringProperty(name="BVH", subtype="FILE_PATH"),
         "frame_start": IntProperty(
             name="Start", min=0, default=0,
@@ -74,45 +159,33 @@ class AvatarSettings(bpy.types.PropertyGroup):
         "fps": FloatProperty(name="FPS", min=0.0, default=0.0,
                              description="Resample to this rate (0 = the clip's own)"),
         "in_place": BoolProperty(name="In place", default=False),
+        "target_height": FloatProperty(name="Height", min=0.0, max=250.0, default=0.0,
+                                       description="cm (0: keep)"),
+        "target_chest": FloatProperty(name="Chest", min=0.0, max=200.0, default=0.0,
+                                      description="cm (0: keep)"),
+        "target_waist": FloatProperty(name="Waist", min=0.0, max=200.0, default=0.0,
+                                      description="cm (0: keep)"),
+        "target_hips": FloatProperty(name="Hips", min=0.0, max=200.0, default=0.0,
+                                     description="cm (0: keep)"),
+        "seed": IntProperty(name="Seed", min=0, default=0),
+        "realistic": BoolProperty(name="Realistic", default=True,
+                                  description="Draw plausible bodies (off: anything in range)"),
+        "preset": EnumProperty(name="Preset", items=_presets),
     }  # fmt: skip
-
-    def body_params(self) -> dict[str, float]:
-        """The library parameters the Body panel sets."""
-        params = {m: float(getattr(self, m)) for m in MACROS}
-        params.update({f"pca/{a}": float(getattr(self, f"pca_{a}")) for a in ATTRIBUTES})
-        params.update({t.name: float(t.value) for t in self.targets})
-        return params
-
-    def recipe(self, base: dict | None = None) -> dict:
-        """A recipe with this panel's body and rig over ``base`` (an existing character's)."""
-        recipe = dict(base or {})
-        recipe["params"] = {**(recipe.get("params") or {}), **self.body_params()}
-        recipe["rig"] = self.rig
-        return recipe
-
-    def load(self, recipe: dict) -> None:
-        """Set the sliders from a stored recipe (the inverse of ``recipe``)."""
-        params = recipe.get("params") or {}
-        for m in MACROS:
-            setattr(self, m, params.get(m, 0.5))
-        for a in ATTRIBUTES:
-            setattr(self, f"pca_{a}", params.get(f"pca/{a}", 0.0))
-        self.targets.clear()
-        known = set(MACROS) | {f"pca/{a}" for a in ATTRIBUTES}
-        for name, value in params.items():
-            if name not in known and "/" in name and not name.startswith(("pca/", "expression/")):
-                item = self.targets.add()
-                item.name, item.value = name, value
-        if recipe.get("rig") in RIGS:
-            self.rig = recipe["rig"]
 
     def motion(self) -> dict:
         """The Motion panel as the spec ``avatar.blender.character`` takes."""
         frames = None
         if self.frame_start or self.frame_end:
             frames = [self.frame_start, self.frame_end or None]  # a Python slice, A:B
-        return {"path": bpy.path.abspath(self.bvh_path), "frames": frames,
-                "fps": self.fps or None, "in_place": self.in_place}  # fmt: skip
+        return {"path": bpy.path.abspath(self.bvh_path) if self.bvh_path else "",
+                "frames": frames, "fps": self.fps or None, "in_place": self.in_place}  # fmt: skip
+
+    def measurements(self) -> dict:
+        """The measurement targets set (metres)."""
+        names = ("height", "chest", "waist", "hips")
+        return {n: getattr(self, f"target_{n}") / 100.0 for n in names
+                if getattr(self, f"target_{n}") > 0}  # fmt: skip
 
 
 class AvatarPreferences(bpy.types.AddonPreferences):

@@ -1,104 +1,135 @@
-"""Characters remember their recipe; update rebuilds in place; errors leave the scene alone."""
+"""The extension's engine (``avatar.blender.character`` and ``live``) on real characters:
+recipes stored, bodies changed in place, garments added and removed, failures that change
+nothing, motion applied through a swap. Skipped without the MakeHuman assets."""
 
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from bridge_fixtures import box_mesh, skeleton
+from bridge_fixtures import box_mesh
+
+ROOT = Path(__file__).resolve().parents[2]
+FIXTURES = Path(os.environ.get("AVATAR_FIXTURES", ROOT.parent / "shared" / "fixtures"))
+WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
 
 
-class FakeHuman:
-    """Stands in for avatar.human.Human: height scales a box on a fixed skeleton."""
+@pytest.fixture(scope="module")
+def assets():
+    from avatar.body import assets as found
+    from avatar.errors import AssetError
 
-    def __init__(self, recipe):
-        from avatar.errors import ParameterError
-
-        self.spec = recipe
-        self.recipe = SimpleNamespace(clothes=())  # wears nothing: no garment bake
-        height = recipe["params"].get("height", 0.5)
-        if not 0 <= height <= 1:
-            raise ParameterError("height out of range")
-        self.mesh = box_mesh((0, 0, 0), (0.4, 0.3, 1.0 + height))
-        self.skeleton = skeleton(np.random.default_rng(1))
-        self.weights = (np.zeros((8, 1), np.int32), np.ones((8, 1)))
-        self.body = None  # the shaped-body record retargeting settles on
-
-    def to_recipe(self):
-        return self.spec
-
-    def parts(self):
-        from avatar.part import MeshPart
-
-        return [MeshPart("body", self.mesh, None, self.weights)]
+    try:
+        found.find_data_dir()
+    except AssetError as exc:
+        pytest.skip(f"MakeHuman assets not installed: {exc}")
 
 
-@pytest.fixture
-def fake_library(monkeypatch):
-    from avatar.blender import character
+def _body(built):
+    from avatar.blender import live, mesh
 
-    monkeypatch.setattr(character, "realise", FakeHuman)
-    return character
+    return mesh.read_vertices(live.part_objects(built.root)["body"])
 
 
-def height_of(built):
-    from avatar.blender.scene import world_bounds
+def test_create_stores_the_recipe_and_update_changes_it_in_place(empty_scene, assets):
+    from avatar.blender import character, live
+    from avatar.human import Human
 
-    lo, hi = world_bounds(built.parts)
-    return hi[2] - lo[2]
-
-
-def test_create_stores_the_recipe_and_update_rebuilds(empty_scene, fake_library):
-    import bpy
-
-    character = fake_library
     built = character.create({"params": {"height": 0.2}}, name="Eve", location=(1, 0, 0))
-    assert character.recipe_of(built.parts[0]) == {"params": {"height": 0.2}}
-    assert height_of(built) == pytest.approx(1.2)
+    assert built.root.name == "Eve" and tuple(built.root.location) == (1, 0, 0)
+    assert json.loads(built.root["avatar_recipe"])["params"] == {"height": 0.2}
+    body = live.part_objects(built.root)["body"]
     again = character.update(built.parts[0], {"params": {"height": 0.8}})
-    assert again.root.name == "Eve" and tuple(again.root.location) == (1, 0, 0)
-    assert height_of(again) == pytest.approx(1.8)
-    assert len([o for o in bpy.data.objects if o.type == "ARMATURE"]) == 1
-    assert len(bpy.data.meshes) == 1  # the old body's mesh went with it
+    assert again.root == built.root and live.part_objects(again.root)["body"] == body
+    np.testing.assert_allclose(_body(again), Human({"height": 0.8}).mesh.vertices, atol=1e-5)
 
 
-def test_failed_update_keeps_the_old_character(empty_scene, fake_library):
+def test_unrigged_characters_have_the_body_as_root(empty_scene, assets):
+    from avatar.blender import character, live
+
+    built = character.create({"params": {}, "clothes": ["eyebrows"]}, rigged=False)
+    assert built.armature is None and built.root.type == "MESH"
+    assert set(live.part_objects(built.root)) == {"body", "eyes", "eyebrows"}
+    live.set_params(built.root, {"weight": 0.9})
+    assert json.loads(built.root["avatar_recipe"])["params"]["weight"] == 0.9
+
+
+def test_failed_update_keeps_the_old_character(empty_scene, assets):
+    from avatar.blender import character
     from avatar.errors import AvatarError
 
-    character = fake_library
-    built = character.create({"params": {"height": 0.5}})
-    with pytest.raises(AvatarError, match="out of range"):
-        character.update(built.root, {"params": {"height": 7.0}})
-    assert json.loads(built.root["avatar_recipe"]) == {"params": {"height": 0.5}}
+    built = character.create({"params": {"height": 0.5}, "clothes": ["eyebrows"]})
+    before, recipe = _body(built).copy(), built.root["avatar_recipe"]
+    bad_recipes = (
+        {"params": {"height": float("nan")}},
+        {"params": {"heigth": 0.3}},
+        {"params": {}, "clothes": ["no-such-garment"]},
+        {"params": {}, "rig": "nope"},
+    )
+    for bad in bad_recipes:
+        with pytest.raises(AvatarError):
+            character.update(built.root, bad)
+        np.testing.assert_array_equal(_body(built), before)
+        assert built.root["avatar_recipe"] == recipe
 
 
-def test_motion_is_applied_and_survives_update(empty_scene, fake_library, monkeypatch):
-    from bridge_fixtures import random_animation
+def test_template_meshes_carry_the_skin_weights(empty_scene, assets):
+    from avatar.blender import character
+    from avatar.human import Human
 
-    import avatar.motion
+    first = character.create({"params": {}})
+    second = character.create({"params": {"weight": 1.0}})
+    human = Human()
+    for built in (first, second):
+        body = built.parts[0]
+        names = [g.name for g in body.vertex_groups]
+        assert names == list(human.skeleton.names)
+        weights = np.zeros((len(body.data.vertices), len(names)))
+        for v in body.data.vertices:
+            for g in v.groups:
+                weights[v.index, g.group] = g.weight
+        skin = human.body.skin_weights
+        want = np.zeros_like(weights)
+        np.put_along_axis(want, skin.indices, skin.weights, axis=1)
+        np.testing.assert_allclose(weights, want, atol=1e-6)
+        assert body.data.materials[0] is not None
 
-    character = fake_library
-    calls = []
 
-    def retarget(source, clip, target, body, frames, fps, in_place):
-        calls.append((clip, frames, fps, in_place))
-        # the Motion panel retargets onto the Human's body (its skin settles the feet)
-        return random_animation(target, np.random.default_rng(2), frames=6), None
+@pytest.mark.skipif(not WALK.is_file(), reason="needs the CMU BVH fixtures")
+def test_motion_is_applied_and_survives_update(empty_scene, assets):
+    from avatar.blender import character, live
 
-    monkeypatch.setattr(avatar.motion, "load_bvh", lambda path: (None, path))
-    monkeypatch.setattr(avatar.motion, "retarget", retarget)
-    built = character.create({"params": {}})
-    built_name = built.root.name
-    spec = {"path": "walk.bvh", "frames": [1, 7], "fps": 30, "in_place": False}
+    built = character.create({"params": {}, "clothes": ["eyebrows"]}, name="Walker")
+    spec = {"path": str(WALK), "frames": [1, 7], "fps": None, "in_place": False}
     moved, summary = character.apply_motion(built.parts[0], spec)
-    assert "6 frames" in summary and moved.root.name == built_name
+    assert moved.root.name == "Walker" and "6 frames" in summary
     assert moved.root.animation_data.action is not None
-    again = character.update(moved.root, {"params": {"height": 0.9}})
+    again = character.update(moved.root, {"params": {"height": 0.9}, "clothes": ["eyebrows"]})
+    assert json.loads(again.root["avatar_motion"]) == spec  # the motion is re-applied
     assert again.root.animation_data.action is not None
-    assert json.loads(again.root["avatar_motion"]) == spec
-    assert calls[-1] == ("walk.bvh", slice(1, 7), 30, False)
+    assert set(live.part_objects(again.root)) == {"body", "eyes", "eyebrows"}
+
+
+def test_a_failed_motion_never_deletes_the_character(empty_scene, assets, tmp_path):
+    import bpy
+
+    from avatar.blender import character
+    from avatar.errors import AvatarError
+
+    built = character.create({"params": {}}, name="Keeper")
+    names = sorted(o.name for o in bpy.data.objects)
+    for path in (tmp_path / "missing.bvh", ""):
+        with pytest.raises(AvatarError):
+            character.apply_motion(built.root, {"path": str(path), "frames": None})
+    bad = tmp_path / "bad.bvh"
+    bad.write_text("HIERARCHY\nROOT Hips\n{\n")
+    with pytest.raises(AvatarError):
+        character.apply_motion(built.root, {"path": str(bad), "frames": None})
+    assert sorted(o.name for o in bpy.data.objects) == names
 
 
 def test_not_a_character(empty_scene):

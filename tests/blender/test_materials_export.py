@@ -56,14 +56,40 @@ def test_masked_alpha_and_tint(empty_scene):
     from avatar.blender import materials
     from avatar.material import Material
 
-    cards = np.zeros((4, 4, 4), np.uint8)
+    cards = np.full((4, 4, 4), 200, np.uint8)
     record = Material("hair", base_color=(0.5, 0.4, 0.3, 1.0), base_color_texture=cards,
                       alpha_mode="MASK", double_sided=True)  # fmt: skip
     mat = materials.material(record)
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     assert bsdf.inputs["Alpha"].links[0].from_node.operation == "GREATER_THAN"
-    assert bsdf.inputs["Base Color"].links[0].from_node.blend_type == "MULTIPLY"
+    # The tint is baked into the pixels: the image feeds Base Color directly (FBX keeps it).
+    image_node = bsdf.inputs["Base Color"].links[0].from_node
+    assert image_node.type == "TEX_IMAGE"
+    pixels = np.empty(4 * 4 * 4, np.float32)
+    image_node.image.pixels.foreach_get(pixels)
+    srgb = 200 / 255
+    linear = ((srgb + 0.055) / 1.055) ** 2.4 * np.array([0.5, 0.4, 0.3])
+    expected = 1.055 * linear ** (1 / 2.4) - 0.055
+    np.testing.assert_allclose(pixels.reshape(-1, 4)[:, :3], np.tile(expected, (16, 1)),
+                               atol=1 / 255)  # fmt: skip
+    assert pixels.reshape(-1, 4)[0, 3] == pytest.approx(200 / 255, abs=1e-6)  # alpha kept
     assert not mat.use_backface_culling
+
+
+def test_equal_records_share_one_material_and_release_frees_it(empty_scene, rng):
+    import bpy
+
+    from avatar.blender import materials
+    from avatar.material import Material
+
+    texture = rng.integers(0, 256, size=(8, 8, 3), dtype=np.uint8)
+    first = materials.material(Material("cloth", base_color_texture=texture))
+    again = materials.material(Material("cloth", base_color_texture=texture.copy()))
+    other = materials.material(Material("cloth", base_color_texture=255 - texture))
+    assert again == first and other != first  # equal content: the same datablock
+    assert len(bpy.data.images) == 2
+    materials.release([first, other])  # nothing uses them: both go, with their images
+    assert len(bpy.data.materials) == 0 and len(bpy.data.images) == 0
 
 
 @pytest.mark.parametrize("suffix", [".fbx", ".usdc", ".blend"])

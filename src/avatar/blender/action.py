@@ -1,4 +1,8 @@
-"""Animation record -> Blender action on an armature (Blender 4.4+ slotted actions).
+"""Animation record -> Blender action on an armature.
+
+Slotted actions (Blender 4.4+: ``Action.slots``, F-curves in a slot's channelbag) are
+feature-detected; older Blenders (4.2 LTS, 3.x) get a legacy action whose ``fcurves``
+hold the curves. Both paths write the same curves.
 
 Keyframes are written as whole arrays with ``foreach_set`` (about 6x faster than
 ``keyframe_insert``), one F-curve per quaternion/location channel, linear interpolation
@@ -9,7 +13,6 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from bpy_extras import anim_utils
 
 from avatar.rig.skeleton import Animation
 
@@ -55,14 +58,34 @@ def _write_channels(channelbag, group, bone: str, prop: str, frames, values) -> 
 
 
 def new_action(owner, id_type: str, name: str):
-    """A new action with one slot for ``owner`` (an Object, a Key, ...; ``id_type`` its
-    slot type, e.g. "OBJECT", "KEY"), assigned to it. Returns (action, its channelbag)."""
+    """A new action assigned to ``owner`` (an Object, a Key, ...; ``id_type`` its slot type,
+    e.g. "OBJECT", "KEY"). Returns (action, the collection to add F-curves and groups to):
+    the slot's channelbag where actions have slots, else the legacy action itself (its
+    ``fcurves.new`` and ``groups.new`` take the same arguments)."""
     action = bpy.data.actions.new(name)
-    slot = action.slots.new(id_type=id_type, name=owner.name)
     owner.animation_data_create()
+    if not has_slots():
+        owner.animation_data.action = action
+        return action, action
+    from bpy_extras import anim_utils
+
+    slot = action.slots.new(id_type=id_type, name=owner.name)
     owner.animation_data.action = action
     owner.animation_data.action_slot = slot
     return action, anim_utils.action_ensure_channelbag_for_slot(action, slot)
+
+
+def has_slots() -> bool:
+    """Whether this Blender has slotted actions (4.4+)."""
+    return "slots" in bpy.types.Action.bl_rna.properties
+
+
+def action_curves(action: bpy.types.Action):
+    """Every F-curve of an action, slotted (4.4+: all its channelbags) or legacy."""
+    if not has_slots():
+        return list(action.fcurves)
+    return [c for layer in action.layers for strip in layer.strips
+            for bag in strip.channelbags for c in bag.fcurves]  # fmt: skip
 
 
 def write_curve(channelbag, path: str, frames, values, interpolation: int, index: int = 0,

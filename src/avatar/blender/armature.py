@@ -6,7 +6,6 @@ from collections.abc import Sequence
 
 import bpy
 import numpy as np
-from mathutils import Matrix
 
 from avatar.rig.skeleton import Skeleton
 
@@ -29,44 +28,95 @@ def new_armature_object(
 
 
 def _add_edit_bones(data: bpy.types.Armature, skeleton: Skeleton) -> None:
-    lengths = np.maximum(skeleton.lengths, 1e-4)  # Blender deletes zero-length bones
-    bones = []
-    for name, rest, length in zip(skeleton.names, skeleton.rest, lengths, strict=True):
-        bone = data.edit_bones.new(name)
-        bone.head = (0.0, 0.0, 0.0)
-        bone.tail = (0.0, float(length), 0.0)
-        # Setting .matrix keeps the length and derives head, tail and roll from it.
-        bone.matrix = Matrix(_orthonormal(rest).tolist())
-        bones.append(bone)
+    bones = [data.edit_bones.new(name) for name in skeleton.names]
     for bone, parent in zip(bones, skeleton.parents, strict=True):
+        bone.tail = (0.0, 1.0, 0.0)  # a bone needs a length before it can be placed
         if parent >= 0:
             bone.parent = bones[parent]
+    _place_edit_bones(data, skeleton)
+
+
+def _place_edit_bones(data: bpy.types.Armature, skeleton: Skeleton) -> None:
+    """Every edit bone of ``data`` at ``skeleton``'s rest matrix, in three array writes.
+
+    An edit bone's ``matrix`` setter keeps its current length and derives head, tail and
+    roll from the matrix, so the lengths go in first as tails along Y from the origin.
+    Bones are matched by name; bones the skeleton lacks are left alone.
+    """
+    edit = data.edit_bones
+    index = {name: j for j, name in enumerate(skeleton.names)}
+    order = np.array([index.get(b.name, -1) for b in edit], dtype=np.int64)
+    if np.any(order < 0):
+        raise ValueError("the armature has bones the skeleton lacks")
+    n = len(order)
+    lengths = np.maximum(skeleton.lengths, 1e-4)[order]  # Blender deletes zero-length bones
+    edit.foreach_set("head", np.zeros(3 * n, np.float32))
+    tails = np.zeros((n, 3), np.float32)
+    tails[:, 1] = lengths
+    edit.foreach_set("tail", tails.ravel())
+    # Matrix properties are read and written column-major: transpose each 4x4.
+    matrices = _orthonormal(np.asarray(skeleton.rest, np.float64)[order])
+    columns = np.ascontiguousarray(matrices.transpose(0, 2, 1), np.float32)
+    edit.foreach_set("matrix", columns.ravel())
+
+
+def set_rest(armature_obj: bpy.types.Object, skeleton: Skeleton) -> None:
+    """Move the armature's rest bones to ``skeleton.rest`` in place (same bones, by name):
+    one trip through edit mode, whatever mode the armature was in (restored after)."""
+    with _edit_mode(armature_obj):
+        _place_edit_bones(armature_obj.data, skeleton)
 
 
 def _orthonormal(m: np.ndarray) -> np.ndarray:
-    """(4, 4) with its rotation part re-orthonormalised (SVD), so Blender accepts it exactly."""
-    u, _, vt = np.linalg.svd(m[:3, :3])
+    """(..., 4, 4) with each rotation part re-orthonormalised (SVD), so Blender accepts it
+    exactly."""
+    u, _, vt = np.linalg.svd(m[..., :3, :3])
     out = np.array(m, dtype=np.float64)
-    out[:3, :3] = u @ vt
+    out[..., :3, :3] = u @ vt
     return out
 
 
 class _edit_mode:
-    """Context manager: make ``obj`` active and enter edit mode; restore object mode after."""
+    """Context manager: ``obj`` in edit mode, then back in the mode it was in (object mode
+    for a new one), the previously active object active again. Works from timers and
+    property callbacks too: the operator gets ``obj`` through a context override."""
 
     def __init__(self, obj: bpy.types.Object):
         self.obj = obj
 
     def __enter__(self) -> bpy.types.Object:
-        view_layer = bpy.context.view_layer
-        if bpy.context.object is not None and bpy.context.object.mode != "OBJECT":
-            bpy.ops.object.mode_set(mode="OBJECT")
-        view_layer.objects.active = self.obj
-        bpy.ops.object.mode_set(mode="EDIT")
+        context = bpy.context
+        self.view_layer = context.view_layer
+        self.active = self.view_layer.objects.active
+        self.mode = self.obj.mode
+        current = context.object
+        if current is not None and current is not self.obj and current.mode != "OBJECT":
+            _mode_set(current, "OBJECT")
+        self.view_layer.objects.active = self.obj
+        _mode_set(self.obj, "EDIT")
         return self.obj
 
     def __exit__(self, *exc: object) -> None:
-        bpy.ops.object.mode_set(mode="OBJECT")
+        _mode_set(self.obj, self.mode if self.mode in ("OBJECT", "POSE") else "OBJECT")
+        if self.active is not None and self.active.name in self.view_layer.objects:
+            self.view_layer.objects.active = self.active
+
+
+def _mode_set(obj: bpy.types.Object, mode: str) -> None:
+    """``object.mode_set`` on ``obj``, without the depsgraph evaluations ``bpy.ops`` adds
+    before and after every call (with a few characters in the scene they cost ~10 ms, far
+    more than the mode switch): the operator is called through the module ``bpy.ops`` wraps
+    (its signature gained the context argument's removal in 4.0), else through ``bpy.ops``."""
+    with bpy.context.temp_override(active_object=obj, object=obj):
+        try:
+            from bpy.ops import _op_call  # the C entry point bpy.ops wraps
+        except ImportError:
+            bpy.ops.object.mode_set(mode=mode)
+            return
+        if bpy.app.version >= (4, 0):
+            _op_call("OBJECT_OT_mode_set", {"mode": mode})
+        else:
+            _op_call("OBJECT_OT_mode_set", None, {"mode": mode})
 
 
 def bind(mesh_obj: bpy.types.Object, armature_obj: bpy.types.Object) -> None:

@@ -1,9 +1,13 @@
-"""Characters in a Blender scene that remember their recipe and regenerate from it.
+"""Characters in a Blender scene that remember their recipe: the extension's engine.
 
 The Blender extension's operators call these functions, one per button. A character's root
-object (its armature) stores the recipe as JSON in the ``avatar_recipe`` custom property;
-changing a slider, wearing a garment or applying a motion edits that recipe and rebuilds the
-character from it, in place (same name, location and collection).
+object (its armature, or the body of an unrigged one) stores the recipe as JSON in the
+``avatar_recipe`` custom property: the source of truth for files. A body change is written
+into the existing objects (``avatar.blender.live``); wearing or taking off a garment adds or
+removes that garment's object and refits the others in place; a new rig or a motion (whose
+garments get one corrective shape key per frame) builds a new character and swaps it in.
+Every change computes the new state before touching the scene, so a failure (an
+AvatarError) leaves the character as it was.
 
 A recipe is what ``avatar.human.Human.to_recipe()`` returns and ``Human.from_recipe()``
 accepts: a JSON-able dict (body parameters, rig, clothes, motion).
@@ -16,7 +20,7 @@ above ``avatar.export`` in the layers (see docs/architecture.md).
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import bpy
@@ -24,26 +28,36 @@ from mathutils import Vector
 
 from avatar import export
 from avatar import motion as library
+from avatar.blender import live
+from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
 from avatar.blender import scene as stage
 from avatar.clothes import binder
+from avatar.clothes import library as clothes_library
 from avatar.errors import AvatarError
-from avatar.human import Human
+from avatar.human import Human, Recipe
+from avatar.motion.retarget import RetargetReport
 from avatar.rig.skeleton import Animation
 
-RECIPE_KEY = "avatar_recipe"
+RECIPE_KEY = live.RECIPE_KEY
 MOTION_KEY = "avatar_motion"  # the Motion panel's spec: {"path", "frames", "fps", "in_place"}
+REPORT_KEY = "avatar_motion_report"  # the last retarget's summary (shown in the panel)
+DEFAULT_LOOK = ("hair-short", "eyebrows", "eyelashes")  # what a new human wears
 
 
 def create(
-    recipe: Mapping[str, object], name: str = "Avatar", location=(0.0, 0.0, 0.0)
+    recipe: Mapping[str, object],
+    name: str = "Avatar",
+    location=(0.0, 0.0, 0.0),
+    rigged: bool = True,
+    exact: bool = True,
 ) -> stage.CharacterObjects:
     """Realise ``recipe`` with the library and add the character to the scene.
 
+    exact: fit garments exactly now (else the real-time fit; ``live.settle`` later).
     Raises AvatarError (bad parameters, missing assets, ...) before touching the scene.
     """
-    human = realise(recipe)
-    return stage.build_character(export.character(human, name=name, location=tuple(location)))
+    return live.create(recipe, name, tuple(location), rigged=rigged, exact=exact)
 
 
 def realise(recipe: Mapping[str, object]) -> Human:
@@ -52,15 +66,53 @@ def realise(recipe: Mapping[str, object]) -> Human:
 
 
 def update(obj: bpy.types.Object, recipe: Mapping[str, object]) -> stage.CharacterObjects:
-    """Rebuild the character ``obj`` belongs to from a new recipe, in place.
+    """Give the character ``obj`` belongs to a new recipe.
 
-    The new human is realised first, so a failing recipe leaves the old character intact.
+    Same rig, no motion: body and garments change in place (garments added or removed as
+    objects). Otherwise a new character is built and swapped in. Either way the new state is
+    computed first, so a failing recipe leaves the old character intact.
     """
     root = root_of(obj)
     if root is None:
         raise AvatarError(f"{obj.name!r} is not part of an Avatar character")
+    new = Recipe.from_dict(dict(recipe))
+    old = live.recipe_of(root)
     motion = json.loads(root[MOTION_KEY]) if MOTION_KEY in root.keys() else None
-    return _rebuild(root, recipe, motion)[0]
+    if new.rig == old.rig and motion is None:
+        return _restyle(root, new)
+    return _rebuild(root, new.to_dict(), motion)[0]
+
+
+def _restyle(root: bpy.types.Object, recipe: Recipe) -> stage.CharacterObjects:
+    """``recipe`` (same rig) written into ``root``'s character: its body and worn garments
+    in place, new garments as new objects, garments no longer worn removed."""
+    human = Human.from_recipe(recipe)
+    geo = live.geometry(human.recipe, human.model, exact=True)  # may raise: nothing touched
+    parts = live.part_objects(root)
+    worn = {g.name for g in geo.outfit or ()}
+    added = []
+    try:
+        for fitted in geo.outfit or ():
+            if fitted.name not in parts:
+                added.append(live.add_part(root, clothes_library.garment_part(fitted), geo.body))
+    except Exception:
+        for obj in added:
+            _delete_objects([obj])
+        raise
+    stale = [o for n, o in parts.items() if n not in ("body", "eyes") and n not in worn]
+    _delete_objects(stale)
+    live.write(root, geo)
+    live.refresh_materials(root, human)
+    root[RECIPE_KEY] = json.dumps(human.to_recipe())
+    root[live.SETTLED_KEY] = 1
+    return objects_of(root)
+
+
+def objects_of(root: bpy.types.Object) -> stage.CharacterObjects:
+    parts = list(live.part_objects(root).values())
+    arm = root if root.type == "ARMATURE" else None
+    body_first = sorted(parts, key=lambda o: o[live.PART_KEY] != "body")
+    return stage.CharacterObjects(root, arm, body_first)
 
 
 def apply_motion(
@@ -71,8 +123,10 @@ def apply_motion(
     motion: {"path": BVH file, "frames": [start, stop] (see ``load_motion``) or None,
     "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
     updates re-apply it. The character is rebuilt, not just given an action, because its
-    garments get one corrective shape key per frame (``avatar.export.character``).
-    Returns the new objects and a one-line summary.
+    garments get one corrective shape key per frame (``avatar.export.character``); the new
+    one is built before the old one goes, so a failure leaves the character as it was.
+    Returns the new objects and a one-line summary; the retarget report's summary is
+    stored on the root (``REPORT_KEY``).
     """
     root = root_of(obj)
     if root is None or root.type != "ARMATURE":
@@ -82,31 +136,67 @@ def apply_motion(
 
 
 def _rebuild(root: bpy.types.Object, recipe, motion):
-    """(objects, Animation or None): the character ``root`` heads replaced by one realised
-    from ``recipe`` playing ``motion`` (a Motion-panel spec or None). Everything that can
-    fail (realise, retarget, garment bake) runs before the old character is removed."""
+    """(objects, Animation or None): a character realised from ``recipe`` playing
+    ``motion`` (a Motion-panel spec or None) swapped in for the one ``root`` heads. Everything
+    that can fail (realise, retarget, garment bake, building the objects) runs before the
+    old character is removed."""
     human = realise(recipe)
-    animation = load_motion(motion, human) if motion else None
+    animation = report = None
+    if motion:
+        animation, report = load_motion(motion, human)
     name, location = root.name, tuple(root.location)
     collection = root.users_collection[0] if root.users_collection else None
-    character = export.character(human, animation, name=name, location=location)
-    remove(root, drop_collection=False)
-    built = stage.build_character(character, collection)
+    rigged = root.type == "ARMATURE"
+
+    def build() -> stage.CharacterObjects:
+        if animation is None:
+            return live.create(human.recipe, name, location, rigged, collection, exact=True)
+        character = export.character(human, animation, name=name, location=location)
+        built = stage.build_character(character, collection)
+        built.root[live.RIGGED_KEY] = 1
+        built.root[live.SETTLED_KEY] = 1
+        return built
+
+    built = _swap(root, build)
     if motion:
         built.root[MOTION_KEY] = json.dumps(dict(motion))
+        built.root[REPORT_KEY] = report.summary() if report is not None else ""
     return built, animation
 
 
-def load_motion(motion: Mapping[str, object], human: Human) -> Animation:
+def _swap(root: bpy.types.Object, build: Callable[[], stage.CharacterObjects]):
+    """The character ``build()`` makes, in place of ``root``'s: same names, selection kept.
+    ``build`` runs first; if it raises, the old character is untouched."""
+    names = {o[live.PART_KEY]: o.name for o in live.part_objects(root).values()}
+    root_name = root.name
+    built = build()
+    remove(root, drop_collection=False)
+    built.root.name = root_name
+    for obj in built.parts:
+        part = obj.get(live.PART_KEY)
+        if part in names and obj is not built.root:
+            obj.name = names[part]
+    return built
+
+
+def load_motion(motion: Mapping[str, object], human: Human) -> tuple[Animation, RetargetReport]:
     """The Animation of a Motion-panel spec, retargeted onto ``human`` and settled on its
-    skin: planted feet on the floor.
+    skin (planted feet on the floor), and the retarget's quality report. Raises AvatarError
+    for a missing, unreadable or empty clip.
 
     motion["frames"]: [start, stop] source frames as the CLI's ``--frames A:B`` (0-based,
     stop exclusive, None = to the end), or None for the whole clip.
     """
     frames = motion.get("frames")
-    source_skeleton, clip = library.load_bvh(motion["path"])
-    animation, _report = library.retarget(
+    path = Path(str(motion.get("path") or ""))
+    if not str(motion.get("path") or "").strip():
+        raise AvatarError("choose a BVH file first")
+    if not path.is_file():
+        raise AvatarError(f"{path}: no such BVH file")
+    source_skeleton, clip = library.load_bvh(path)
+    if clip.frames == 0:
+        raise AvatarError(f"{path.name}: the clip has no frames")
+    animation, report = library.retarget(
         source_skeleton,
         clip,
         human.skeleton,
@@ -115,7 +205,9 @@ def load_motion(motion: Mapping[str, object], human: Human) -> Animation:
         fps=motion.get("fps"),
         in_place=bool(motion.get("in_place")),
     )
-    return animation
+    if animation.frames == 0:
+        raise AvatarError(f"{path.name}: no frames in {frames[0]}:{frames[1]}")
+    return animation, report
 
 
 def bind_garment(
@@ -174,22 +266,39 @@ def recipe_of(obj: bpy.types.Object | None) -> dict | None:
 
 
 def remove(root: bpy.types.Object, drop_collection: bool = True) -> None:
-    """Delete a character: root, its descendants, their data, its action, and (when
-    ``drop_collection``) the collection named after it once that is empty."""
-    objects = [root, *root.children_recursive]
-    action = root.animation_data.action if root.animation_data else None
-    datas = [o.data for o in objects if o.data is not None]
+    """Delete a character: root, its descendants, their data, actions and materials that
+    nothing else uses, and (when ``drop_collection``) the collection named after it once
+    that is empty."""
     name = root.name
+    _delete_objects([root, *root.children_recursive])
+    collection = bpy.data.collections.get(name) if drop_collection else None
+    if collection is not None and not collection.all_objects:
+        bpy.data.collections.remove(collection)
+
+
+def _delete_objects(objects: list[bpy.types.Object]) -> None:
+    """Remove objects and whatever of theirs is left unused: mesh/armature data, shape
+    keys' and objects' actions, Avatar's materials and their images."""
+    actions, datas, mats = [], [], []
+    for obj in objects:
+        for owner in (obj, getattr(obj.data, "shape_keys", None)):
+            if owner is not None and owner.animation_data and owner.animation_data.action:
+                actions.append(owner.animation_data.action)
+        if obj.data is not None:
+            datas.append(obj.data)
+            mats += list(getattr(obj.data, "materials", []))
     for obj in objects:
         bpy.data.objects.remove(obj)
     for data in datas:
         if data.users == 0:
             _pool(data).remove(data)
-    if action is not None and action.users == 0:
-        bpy.data.actions.remove(action)
-    collection = bpy.data.collections.get(name) if drop_collection else None
-    if collection is not None and not collection.all_objects:
-        bpy.data.collections.remove(collection)
+    for action in actions:
+        if action.users == 0:
+            bpy.data.actions.remove(action)
+    material_bridge.release(mats)
+    # The view layer resyncs its object list lazily; iterating it before that (selecting
+    # the new character) would meet the removed objects' empty bases.
+    bpy.context.view_layer.update()
 
 
 def _pool(data: bpy.types.ID):

@@ -4,11 +4,22 @@ Mirrors glTF's metallic-roughness model, as the record does: the colour texture 
 by ``base_color``, the roughness texture by ``roughness``; ``alpha_mode`` MASK thresholds
 alpha at ``alpha_cutoff``. Renderer hints in ``extras`` (``subsurface``,
 ``subsurface_radius``, ``sheen``, ``coat``) go to the matching BSDF inputs.
+
+Every image texture feeds its BSDF input directly: a colour factor is baked into the image's
+pixels rather than applied through a Mix node, because the FBX and USD exporters follow
+only an image wired straight to Base Color (a Mix node in between exported no colour).
+
+Materials are made once per content and reused: ``material`` tags each one with a digest of
+its record (``KEY``) and returns the existing one for an equal record, so rebuilding or
+re-creating a character re-packs no image; ``release`` removes those that nothing uses any
+more, with their images.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import hashlib
+import weakref
+from collections.abc import Iterable, Sequence
 
 import bpy
 import numpy as np
@@ -24,10 +35,58 @@ _EXTRAS = {  # Material.extras key -> Principled BSDF input (Blender 4.0+ names)
 }
 
 
+KEY = "avatar_key"  # custom property: the digest of the record a material was made from
+# Digests of records already seen (records are frozen and their arrays read-only): a second
+# character with the same skin hashes nothing.
+_DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def material(record: object | None, fallback_name: str = "Material") -> bpy.types.Material:
-    """A new node material from a Material record (a plain grey one for None)."""
+    """The node material of a Material record (a plain grey one for None): an existing one
+    made from an equal record (same name, factors and texture pixels) when there is one,
+    else a new one tagged with the record's digest."""
     if record is None:
         return plain(fallback_name, _GREY)
+    key = digest(record)
+    found = next((m for m in bpy.data.materials if m.get(KEY) == key), None)
+    if found is not None:
+        return found
+    mat = _new_material(record, fallback_name)
+    mat[KEY] = key
+    return mat
+
+
+def digest(record) -> str:
+    """A hex digest of everything a Material record draws with (name, factors, pixels)."""
+    known = _DIGESTS.get(record)
+    if known is not None:
+        return known
+    h = hashlib.blake2b(digest_size=16)
+    h.update(repr((record.name, tuple(record.base_color), record.roughness, record.metallic,
+                   record.normal_scale, record.alpha_mode, record.alpha_cutoff,
+                   record.double_sided, sorted((k, repr(v)) for k, v in
+                                               record.extras.items()))).encode())  # fmt: skip
+    for name, image in sorted(record.textures().items()):
+        h.update(f"{name}{image.shape}{image.dtype}".encode())
+        h.update(np.ascontiguousarray(image).data)
+    _DIGESTS[record] = out = h.hexdigest()
+    return out
+
+
+def release(materials: Iterable[bpy.types.Material]) -> None:
+    """Remove the Avatar-made materials among ``materials`` that no object uses any more,
+    and their images that nothing else uses (a rebuilt or deleted character's)."""
+    for mat in {m for m in materials if m is not None}:
+        if KEY not in mat.keys() or mat.users > 0:
+            continue
+        images = [n.image for n in mat.node_tree.nodes if n.type == "TEX_IMAGE" and n.image]
+        bpy.data.materials.remove(mat)
+        for image in images:
+            if image.users == 0:
+                bpy.data.images.remove(image)
+
+
+def _new_material(record, fallback_name: str) -> bpy.types.Material:
     mat, bsdf = _principled(record.name or fallback_name)
     rgba = tuple(float(c) for c in record.base_color)
     bsdf.inputs["Base Color"].default_value = rgba
@@ -94,9 +153,11 @@ def _link_colour(mat: bpy.types.Material, bsdf: bpy.types.Node, record) -> None:
     if image is None:
         return
     tree = mat.node_tree
+    image = tinted(image, record.base_color)
     node = _image_node(tree, image_from_array(f"{record.name} colour", image), (-700, 300))
-    colour_out = _multiply_colour(tree, node.outputs["Color"], record.base_color)
-    tree.links.new(colour_out, bsdf.inputs["Base Color"])
+    # Straight into Base Color: exporters (FBX, USD) follow no node in between.
+    tree.links.new(node.outputs["Color"], bsdf.inputs["Base Color"])
+    bsdf.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     mat.diffuse_color = (*_mean_colour(image), 1.0)
     if image.ndim == 3 and image.shape[2] == 4:
         alpha = node.outputs["Alpha"]
@@ -106,18 +167,20 @@ def _link_colour(mat: bpy.types.Material, bsdf: bpy.types.Node, record) -> None:
             tree.links.new(alpha, bsdf.inputs["Alpha"])
 
 
-def _multiply_colour(tree, colour_socket, factor) -> bpy.types.NodeSocket:
-    """colour * factor.rgb through a Mix node, skipped when the factor is white."""
-    if all(abs(float(c) - 1.0) < 1e-6 for c in factor[:3]):
-        return colour_socket
-    mix = tree.nodes.new("ShaderNodeMix")
-    mix.data_type, mix.blend_type, mix.location = "RGBA", "MULTIPLY", (-350, 300)
-    # The Mix node has float, vector and colour sockets of the same names: pick by identifier.
-    inputs = {s.identifier: s for s in mix.inputs}
-    inputs["Factor_Float"].default_value = 1.0
-    tree.links.new(colour_socket, inputs["A_Color"])
-    inputs["B_Color"].default_value = (*[float(c) for c in factor[:3]], 1.0)
-    return next(s for s in mix.outputs if s.identifier == "Result_Color")
+def tinted(image: np.ndarray, factor: Sequence[float]) -> np.ndarray:
+    """(H, W, C) uint8 sRGB image times a linear RGB ``factor`` (glTF's baseColorFactor),
+    multiplied in linear light and encoded back to sRGB; alpha kept. The image itself when
+    the factor is white."""
+    rgb = np.asarray([float(c) for c in factor[:3]], np.float32)
+    if np.all(np.abs(rgb - 1.0) < 1e-6):
+        return image
+    srgb = np.asarray(image[..., :3], np.float32) / 255.0
+    linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4) * rgb
+    back = np.where(linear <= 0.0031308, linear * 12.92,
+                    1.055 * np.maximum(linear, 0.0031308) ** (1 / 2.4) - 0.055)  # fmt: skip
+    out = np.array(image, copy=True)
+    out[..., :3] = np.clip(np.rint(back * 255.0), 0, 255).astype(np.uint8)
+    return out
 
 
 def _mean_colour(image: np.ndarray) -> tuple[float, float, float]:

@@ -103,6 +103,7 @@ def _build_part(
     collection: bpy.types.Collection,
 ) -> bpy.types.Object:
     obj = mesh_bridge.new_mesh_object(part.name, part.mesh, collection)
+    obj["avatar_part"] = part.name  # what the extension's live updates find it by
     obj.data.materials.append(material_bridge.material(part.material, part.name))
     if part.normals is not None:
         mesh_bridge.set_normals(obj, part.normals)

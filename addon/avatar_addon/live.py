@@ -1,0 +1,153 @@
+"""Property changes -> the library's in-place updates (``avatar.blender.live``).
+
+A slider (or a script) setting ``object.avatar.weight`` calls ``apply_params``: the body,
+skeleton and garments move at once, fitted the real-time way; a timer then settles the
+character (garments exact, skin texture of the new ethnicity/age/gender, measurements)
+once no change came for ``SETTLE_DELAY`` seconds. Headless scripts, where timers do not
+run, call ``settle_now`` (``bpy.ops.avatar.settle``).
+
+Errors inside a property callback cannot reach the status bar: they are logged and kept
+on the object (``ERROR_KEY``) for the Body panel to show; the character is left unchanged.
+"""
+
+import logging
+import time
+from contextlib import contextmanager
+
+import bpy
+
+log = logging.getLogger(__name__)
+
+SETTLE_DELAY = 0.3  # s of no change before the exact pass
+ERROR_KEY = "avatar_error"
+_SUSPENDED: set = set()  # roots whose callbacks are off (while many properties are set)
+_PENDING: dict = {}  # root name -> time of its last change, waiting to settle
+
+
+@contextmanager
+def suspended(root):
+    """Set many properties of ``root.avatar`` with one update at most (by the caller)."""
+    _SUSPENDED.add(root.name_full)
+    try:
+        yield
+    finally:
+        _SUSPENDED.discard(root.name_full)
+
+
+def apply_params(root) -> bool:
+    """Write ``root.avatar``'s parameters into its character; True when it changed."""
+    if root.name_full in _SUSPENDED:
+        return False
+    from avatar.blender import live
+    from avatar.errors import AvatarError
+
+    try:
+        live.set_params(root, root.avatar.params())
+    except AvatarError as exc:
+        root[ERROR_KEY] = str(exc)
+        log.error("Avatar: %s", exc)
+        return False
+    if ERROR_KEY in root.keys():
+        del root[ERROR_KEY]
+    schedule_settle(root)
+    return True
+
+
+def schedule_settle(root) -> None:
+    """Settle ``root``'s character once it has had no change for ``SETTLE_DELAY`` s."""
+    _PENDING[root.name_full] = time.monotonic()
+    if not bpy.app.timers.is_registered(_settle_pending):
+        bpy.app.timers.register(_settle_pending, first_interval=SETTLE_DELAY)
+
+
+def _settle_pending():
+    now = time.monotonic()
+    for name, when in list(_PENDING.items()):
+        if now - when < SETTLE_DELAY:
+            continue
+        del _PENDING[name]
+        root = bpy.data.objects.get(name)
+        if root is not None:
+            try:
+                settle_now(root)
+            except Exception as exc:  # noqa: BLE001 - a timer must never raise into Blender
+                log.error("Avatar: settling %s failed: %s", name, exc)
+    return SETTLE_DELAY if _PENDING else None
+
+
+def settle_now(root) -> None:
+    """The exact pass on ``root``'s character now; measurements refreshed."""
+    from avatar.blender import live
+    from avatar.body import measures
+
+    _PENDING.pop(root.name_full, None)
+    geo = live.settle(root)
+    got = measures.measure(geo.body.vertices, geo.body.model.base)
+    with suspended(root):
+        for name, value in got.items():
+            setattr(root.avatar, f"measured_{name}", value * 100.0)
+
+
+def normalise_races(props, changed: str) -> None:
+    """MakeHuman's ethnicity mix: the other two races share what ``changed`` leaves, in
+    their current proportion (equally when both are 0), so the three sum to 1."""
+    root = props.id_data
+    if root.name_full in _SUSPENDED:
+        return
+    from .properties import RACES
+
+    others = [r for r in RACES if r != changed]
+    left = max(0.0, 1.0 - getattr(props, changed))
+    total = sum(getattr(props, r) for r in others)
+    with suspended(root):
+        for r in others:
+            share = getattr(props, r) / total if total > 1e-9 else 0.5
+            setattr(props, r, left * share)
+
+
+def change_rig(root, rig: str) -> None:
+    """A new rig is a new armature: rebuild the character (the operator path)."""
+    if root.name_full in _SUSPENDED:
+        return
+    from avatar.blender import character
+    from avatar.errors import AvatarError
+
+    recipe = character.recipe_of(root)
+    if recipe.get("rig") == rig:
+        return
+    recipe["rig"] = rig
+    try:
+        built = character.update(root, recipe)
+    except AvatarError as exc:
+        root[ERROR_KEY] = str(exc)
+        log.error("Avatar: %s", exc)
+        return
+    sync_from_recipe(built.root)
+
+
+def sync_from_recipe(root) -> None:
+    """Set ``root.avatar`` from the stored recipe (no update runs): after a create, a
+    rebuild, a preset or an undo of something the properties do not hold."""
+    from avatar.blender import character
+
+    from . import catalogue
+    from .properties import ATTRIBUTES, MACROS, RACES
+
+    recipe = character.recipe_of(root)
+    params = recipe.get("params") or {}
+    props = root.avatar
+    with suspended(root):
+        for m in (*MACROS, *RACES):
+            setattr(props, m, params.get(m, 1 / 3 if m in RACES else 0.5))
+        for a in ATTRIBUTES:
+            setattr(props, f"pca_{a}", params.get(f"pca/{a}", 0.0))
+        if recipe.get("rig") and recipe["rig"] != props.rig:
+            props.rig = recipe["rig"]
+        if len(props.modifiers) == 0:
+            for name, label, group, minimum in catalogue.modifier_rows():
+                item = props.modifiers.add()
+                item.name, item.label, item.group, item.minimum = name, label, group, minimum
+        for item in props.modifiers:
+            value = params.get(item.name, 0.0)
+            if item.value != value:
+                item.value = value

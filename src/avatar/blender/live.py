@@ -1,0 +1,358 @@
+"""Characters that change in place: a recipe's geometry written into the objects it has.
+
+A character made here is a root object (its armature, or its body for an unrigged one)
+holding the recipe as JSON (``RECIPE_KEY``), and mesh parts tagged with ``PART_KEY``
+("body", "eyes", a garment's name). A parameter change (``set_params``) computes the new
+body, skeleton and fitted garments with the library (``avatar.body.shaped``,
+``avatar.clothes.library.dress``) and writes them into those objects: vertices with
+``foreach_set`` (shape keys keep their offsets), the armature's rest bones in one trip
+through edit mode. No object, mesh, material or image is created. Materials come from
+``avatar.blender.materials.material``, which reuses any made from an equal record.
+
+Two speeds: a slider change fits garments the real-time way (``exact=False``: a few
+milliseconds a garment); ``settle`` then does what a freshly realised ``Human`` has (every
+garment vertex tested out of the body, the skin texture of the new ethnicity, age and
+gender) once the slider rests. New meshes are copies of a template per topology and rig
+(``template_mesh``): faces, UVs and vertex groups are copied in C, only positions written.
+
+Nothing here keeps Blender references between calls (undo invalidates them); the caches
+hold library records keyed by value.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import bpy
+import numpy as np
+
+from avatar.blender import armature as armature_bridge
+from avatar.blender import materials as material_bridge
+from avatar.blender import mesh as mesh_bridge
+from avatar.blender.scene import CharacterObjects, new_collection
+from avatar.body import shaped
+from avatar.body.model import BodyModel
+from avatar.body.shaped import PART_GROUPS, Body
+from avatar.clothes import builtin, library
+from avatar.clothes.fitting import FittedGarment, Garment, Outfit
+from avatar.errors import AvatarError
+from avatar.human import Human, Recipe
+from avatar.mesh import Mesh
+from avatar.part import MeshPart
+
+log = logging.getLogger(__name__)
+
+RECIPE_KEY = "avatar_recipe"
+PART_KEY = "avatar_part"  # on each mesh part: "body", "eyes" or the garment's name
+RIGGED_KEY = "avatar_rigged"  # on the root: 0 for a character made without an armature
+SETTLED_KEY = "avatar_settled"  # on the root: 1 once garments and skin are exact
+TEMPLATE_KEY = "avatar_template"  # on template meshes: their cache key
+
+
+@dataclass(frozen=True, eq=False)
+class Geometry:
+    """What a recipe looks like at rest: the shaped body on its rig, and its outfit."""
+
+    recipe: Recipe
+    body: Body
+    outfit: Outfit | None
+
+    def part_vertices(self, part: str) -> np.ndarray:
+        """(n, 3) float32 the vertices of a body part ("body", "eyes") in its mesh's order."""
+        return self.body.vertices[_part_index(self.body.model, part)]
+
+
+def geometry(recipe: Recipe, model: BodyModel | None = None, exact: bool = True) -> Geometry:
+    """The body, skeleton and garments of ``recipe``, as ``Human.from_recipe`` realises
+    them (``exact`` outfit), or fitted the real-time way (``exact=False``)."""
+    model = model or BodyModel.shared()
+    vertices = shaped.rest_vertices(model, model.resolve(recipe.params))
+    skeleton = _rig_definition(model, recipe.rig).skeleton(vertices)
+    body = Body(vertices, skeleton, model.skin_weights(recipe.rig, tuple(skeleton.names)),
+                model, recipe.rig)  # fmt: skip
+    garments = [garment(entry, model) for entry in recipe.clothes]
+    outfit = library.dress(body, garments, exact=exact) if garments else None
+    return Geometry(recipe, body, outfit)
+
+
+@lru_cache(maxsize=16)
+def _rig_definition(model: BodyModel, rig: str):
+    return shaped.rig_definition(model, rig)
+
+
+@lru_cache(maxsize=8)
+def _part_index(model: BodyModel, part: str) -> np.ndarray:
+    return shaped.part_vertices(model, part)
+
+
+_USER_GARMENTS: dict[tuple[str, float], Garment] = {}
+
+
+def garment(entry: str, model: BodyModel | None = None) -> Garment:
+    """The Garment of a recipe entry: built-ins from the library's cache, a user's
+    ``.mhclo`` read once per file version (its anchors then stay cached with it)."""
+    source = library.find_garment(entry)
+    if source in builtin.BY_NAME:
+        return library.load_garment(source, model=model)
+    key = (os.path.abspath(source), os.path.getmtime(source))
+    if key not in _USER_GARMENTS:
+        _USER_GARMENTS[key] = library.load_garment(source, model=model)
+    return _USER_GARMENTS[key]
+
+
+# ---------------------------------------------------------------------------- creating
+
+
+def create(
+    recipe: Mapping[str, object] | Recipe,
+    name: str = "Avatar",
+    location: Sequence[float] = (0.0, 0.0, 0.0),
+    rigged: bool = True,
+    collection: bpy.types.Collection | None = None,
+    exact: bool = False,
+) -> CharacterObjects:
+    """Add a character realised from ``recipe`` to the scene (in a new collection named
+    after it unless ``collection`` is given).
+
+    rigged: False makes a bare body (no armature; the root is the body mesh).
+    exact: fit garments exactly now; by default they are fitted the real-time way and
+    ``settle`` makes them exact (the extension runs it once the scene is idle).
+    Raises AvatarError (unknown names, missing assets) before anything is added.
+    """
+    human = Human.from_recipe(recipe if isinstance(recipe, Recipe) else dict(recipe))
+    geo = geometry(human.recipe, human.model, exact)
+    made_collection = collection is None
+    collection = collection or new_collection(name)
+    before = set(bpy.data.objects)
+    try:
+        return _create(human, geo, name, location, rigged, collection, exact)
+    except Exception:
+        for obj in set(bpy.data.objects) - before:
+            bpy.data.objects.remove(obj)
+        if made_collection:
+            bpy.data.collections.remove(collection)
+        raise
+
+
+def _create(human: Human, geo: Geometry, name, location, rigged, collection, exact):
+    arm = None
+    if rigged:
+        arm = armature_bridge.new_armature_object(name, geo.body.skeleton, collection)
+    parts = [_new_part(p, geo.body, arm, collection, mesh) for p, mesh in _parts(human, geo)]
+    root = arm or parts[0]
+    if arm is None:  # the body is the root: the other parts hang under it
+        for obj in parts[1:]:
+            obj.parent = root
+    root.location = tuple(location)
+    root[RECIPE_KEY] = json.dumps(human.to_recipe())
+    root[RIGGED_KEY] = int(rigged)
+    root[SETTLED_KEY] = int(exact or geo.outfit is None)
+    return CharacterObjects(root, arm, parts)
+
+
+def _parts(human: Human, geo: Geometry) -> list[tuple[MeshPart, Mesh]]:
+    """(MeshPart with material and skin, its mesh on this body) per part, body first."""
+    out = []
+    weights = geo.body.weights
+    for part in PART_GROUPS:
+        index = _part_index(geo.body.model, part)
+        skin = weights.subset(index)
+        mesh = human.part(part) if part == "eyes" else _body_mesh(geo)
+        out.append((MeshPart(part, mesh, _body_material(human, part),
+                             (skin.indices, skin.weights)), mesh))  # fmt: skip
+    for fitted in geo.outfit or ():
+        part = library.garment_part(fitted)
+        out.append((part, part.mesh))
+    return out
+
+
+def _body_mesh(geo: Geometry) -> Mesh:
+    return _skin_topology(geo.body.model).with_vertices(geo.part_vertices("body"))
+
+
+@lru_cache(maxsize=4)
+def _skin_topology(model: BodyModel) -> Mesh:
+    """The skin part's faces and UVs (as ``Human.part("body")``), made once per model."""
+    base = model.base
+    faces = np.sort(np.concatenate([base.face_groups[g] for g in PART_GROUPS["body"]]))
+    return base.subset(faces)
+
+
+def _body_material(human: Human, part: str):
+    return human.material(part)
+
+
+def _new_part(part: MeshPart, body: Body, arm, collection, mesh: Mesh) -> bpy.types.Object:
+    """A mesh object for ``part`` (a copy of its template, then this body's vertices)."""
+    key = _template_key(part, body.rig if arm is not None else None)
+    data = template_mesh(key, part, body.skeleton.names if arm is not None else None).copy()
+    data.name = part.name
+    data.use_fake_user = False
+    data.pop(TEMPLATE_KEY, None)
+    obj = bpy.data.objects.new(part.name, data)
+    collection.objects.link(obj)
+    write_vertices(obj, mesh.vertices)
+    obj.data.materials.append(material_bridge.material(part.material, part.name))
+    obj[PART_KEY] = part.name
+    if arm is not None:
+        armature_bridge.bind(obj, arm)
+    return obj
+
+
+def add_part(root: bpy.types.Object, part: MeshPart, body: Body) -> bpy.types.Object:
+    """A new part object (e.g. a garment just put on) of the character ``root`` heads:
+    in its collection, skinned to its armature, or parented to its body."""
+    arm = root if root.type == "ARMATURE" else None
+    collection = root.users_collection[0] if root.users_collection else None
+    obj = _new_part(part, body, arm, collection or bpy.context.scene.collection, part.mesh)
+    if arm is None:
+        obj.parent = root
+    return obj
+
+
+def _template_key(part: MeshPart, rig: str | None) -> str:
+    faces = np.ascontiguousarray(part.mesh.faces)
+    digest = hashlib.blake2b(faces.data, digest_size=8).hexdigest()
+    return f"{part.name}:{len(part.mesh.vertices)}:{digest}:{rig or '-'}"
+
+
+def template_mesh(key: str, part: MeshPart, bone_names: Sequence[str] | None) -> bpy.types.Mesh:
+    """The template mesh of a part's topology and rig: faces, UVs and (with ``bone_names``)
+    skin weights as vertex groups, built once and kept hidden ('.avatar ...' orphan data:
+    a new character copies it in C instead of adding thousands of group weights)."""
+    found = next((m for m in bpy.data.meshes if m.get(TEMPLATE_KEY) == key), None)
+    if found is not None:
+        return found
+    data = mesh_bridge.mesh_data(f".avatar {key}", part.mesh)
+    if bone_names is not None and part.skin is not None:
+        holder = bpy.data.objects.new(".avatar template", data)  # groups are set on objects
+        try:
+            mesh_bridge.set_vertex_groups(holder, bone_names, *part.skin)
+        finally:
+            bpy.data.objects.remove(holder)
+    data[TEMPLATE_KEY] = key
+    return data
+
+
+# ---------------------------------------------------------------------------- updating
+
+
+def set_params(root: bpy.types.Object, params: Mapping[str, float]) -> Geometry:
+    """Give the character ``root`` heads these body parameters, in place (real-time fit;
+    ``settle`` after). Raises AvatarError for a bad name or value, before changing anything."""
+    recipe = recipe_of(root)
+    human = Human(params, recipe.rig, recipe=recipe)  # validates: nothing changed yet
+    geo = geometry(human.recipe, human.model, exact=False)
+    write(root, geo)
+    root[RECIPE_KEY] = json.dumps(human.to_recipe())
+    root[SETTLED_KEY] = int(geo.outfit is None)
+    return geo
+
+
+def settle(root: bpy.types.Object) -> Geometry:
+    """Make the character exactly what its recipe realises: garments fitted exactly (no
+    vertex inside the body) and the skin material of its current parameters."""
+    recipe = recipe_of(root)
+    human = Human.from_recipe(recipe)
+    geo = geometry(recipe, human.model, exact=True)
+    write(root, geo)
+    refresh_materials(root, human)
+    root[SETTLED_KEY] = 1
+    return geo
+
+
+def refresh_materials(root: bpy.types.Object, human: Human) -> None:
+    """Give the body and eyes the materials ``human``'s parameters make (the skin depends
+    on ethnicity, age and gender); the old ones go when nothing else uses them."""
+    parts = part_objects(root)
+    for name in PART_GROUPS:
+        obj = parts.get(name)
+        if obj is not None:
+            _swap_material(obj, material_bridge.material(human.material(name), name))
+
+
+def _swap_material(obj: bpy.types.Object, new: bpy.types.Material) -> None:
+    slots = obj.data.materials
+    old = slots[0] if len(slots) else None
+    if old == new:
+        return
+    if len(slots):
+        slots[0] = new
+    else:
+        slots.append(new)
+    material_bridge.release([old])
+
+
+def write(root: bpy.types.Object, geo: Geometry) -> None:
+    """Write ``geo`` into the character's objects: body, eyes, garments, rest bones.
+    Raises AvatarError, before writing, when the character's parts do not match it."""
+    parts = part_objects(root)
+    garments = {g.name: g for g in geo.outfit or ()}
+    missing = [n for n in [*PART_GROUPS, *garments] if n not in parts]
+    if missing:
+        raise AvatarError(f"{root.name!r} has no part {missing[0]!r}: rebuild it")
+    writes = [(parts[n], geo.part_vertices(n)) for n in PART_GROUPS]
+    writes += [(parts[n], g.mesh.vertices) for n, g in garments.items()]
+    for obj, vertices in writes:
+        if len(obj.data.vertices) != len(vertices):
+            raise AvatarError(f"{obj.name!r} no longer has the vertices Avatar made it with")
+    for obj, vertices in writes:
+        write_vertices(obj, vertices)
+    if root.type == "ARMATURE":
+        armature_bridge.set_rest(root, geo.body.skeleton)
+
+
+def write_vertices(obj: bpy.types.Object, vertices: np.ndarray) -> None:
+    """Set a mesh object's rest positions (V, 3) in place; shape keys keep their offsets
+    from the basis (e.g. baked garment corrections)."""
+    data = obj.data
+    flat = np.ascontiguousarray(vertices, dtype=np.float32).ravel()
+    keys = data.shape_keys
+    if keys is not None:
+        old = np.empty_like(flat)
+        keys.reference_key.data.foreach_get("co", old)
+        delta = flat - old
+        buffer = np.empty_like(flat)
+        for block in keys.key_blocks:
+            block.data.foreach_get("co", buffer)
+            block.data.foreach_set("co", buffer + delta)
+    data.vertices.foreach_set("co", flat)
+    data.update_tag()
+    obj.update_tag()
+
+
+# ---------------------------------------------------------------------------- queries
+
+
+def part_objects(root: bpy.types.Object) -> dict[str, bpy.types.Object]:
+    """The character's mesh parts by part name (the root too, when it is the body)."""
+    objects = [root, *root.children_recursive]
+    return {o[PART_KEY]: o for o in objects if o.type == "MESH" and PART_KEY in o.keys()}
+
+
+def recipe_of(root: bpy.types.Object) -> Recipe:
+    if RECIPE_KEY not in root.keys():
+        raise AvatarError(f"{root.name!r} is not an Avatar character")
+    return Recipe.from_dict(json.loads(root[RECIPE_KEY]))
+
+
+def root_of(obj: bpy.types.Object | None) -> bpy.types.Object | None:
+    """The object holding the recipe: ``obj`` or its nearest ancestor that has one."""
+    while obj is not None:
+        if RECIPE_KEY in obj.keys():
+            return obj
+        obj = obj.parent
+    return None
+
+
+def fitted_names(outfit: Outfit | None) -> list[str]:
+    return [g.name for g in outfit or ()]
+
+
+__all__ = ["FittedGarment", "Geometry", "create", "geometry", "set_params", "settle", "write"]
