@@ -15,11 +15,14 @@ garment gets a small basis: the principal components of X (no centring: a frame 
 correction has weights 0), the smallest count k <= ``MAX_BASIS`` whose reconstruction
 (``project``: weights w_t = X_t B^T) leaves no vertex of any frame more than ``ERROR_BOUND``
 from its exact delta; past ``MAX_BASIS`` shapes the count grows further (to ``LIMIT``) only
-if the bound needs it. The file holds k morph targets ``correction_00``.. per garment and
-a (T, k) weights channel: it grows linearly with the clip (k weights a frame), not with its
-square. Because A is a blend of rotations (its norm is at most 1), a bind-space error e
-moves the played-back vertex by at most e: garments are never more than ``ERROR_BOUND``
-inside where the exact frame is outside.
+if the bound needs it. The file holds k morph targets ``correction_00``.. per garment (plus
+``correction_offset``, held at 1, so that every weight lies in [0, 1], the range players
+keep) and a (T, k + 1) weights channel: it grows linearly with the clip (k + 1 weights a
+frame), not with its square. Because A is a blend of rotations (its norm is at most 1), a
+bind-space error e moves the played-back vertex by at most e: garments are never more than
+``ERROR_BOUND`` inside where the exact frame is outside. Corrections that are not low-rank
+at that bound (long, varied clips: see docs/benchmarks.md) hit ``LIMIT`` and are logged
+with the error reached.
 
     parts, weights = bake(human.body, human.outfit, animation, human.parts())
     gltf.write(path, parts, human.skeleton, {"walk": animation}, morph_weights={"walk": weights})
@@ -76,7 +79,8 @@ def bake(
     skin: the weights the player will skin with (default ``file_skin`` with
         ``max_influences``, a glTF viewer's; ``vertex_group_skin`` for Blender's Armature).
     bound: the largest distance (m) a played-back vertex may be from its exact frame.
-    Returns the parts (garments with extra morphs ``correction_00``.. after any they had;
+    Returns the parts (garments with extra morphs ``correction_offset``, ``correction_00``..
+    after any they had;
     deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32 morph
     weights (0 for the morphs they had before), for garments that need a correction.
     """
@@ -185,14 +189,23 @@ def _with_basis(
                     part.name, len(shapes), error * 1e3, bound * 1e3)  # fmt: skip
     log.info("%s: %d frames corrected -> %d shapes, worst error %.3f mm", part.name,
              len(corrections.rows), len(shapes), error * 1e3)  # fmt: skip
+    # Weights in [0, 1], which every player keeps (Blender's shape-key sliders and Unity clamp
+    # to it): w = lo + (hi - lo) u, so x = sum lo_k s_k + sum u_k (hi_k - lo_k) s_k, the
+    # first term an "offset" target held at 1 over the clip (the rest mesh is unchanged).
+    lo, hi = np.minimum(weights.min(axis=0), 0.0), np.maximum(weights.max(axis=0), 0.0)
+    span = np.where(hi - lo > 0, hi - lo, 1.0)
     morphs = dict(part.morphs)
     before = len(morphs)
+    offset = np.zeros((corrections.vertices, 3), dtype=np.float32)
+    offset[moved] = np.einsum("k,kvc->vc", lo, shapes)
+    morphs[f"{BASIS_PREFIX}offset"] = offset
     for k, shape in enumerate(shapes):
         delta = np.zeros((corrections.vertices, 3), dtype=np.float32)
-        delta[moved] = shape
+        delta[moved] = shape * span[k]
         morphs[f"{BASIS_PREFIX}{k:02d}"] = delta
     out = np.zeros((corrections.frames, len(morphs)), dtype=np.float32)
-    out[:, before:] = weights
+    out[:, before] = 1.0
+    out[:, before + 1 :] = np.clip((weights - lo) / span, 0.0, 1.0)
     return replace(part, morphs=morphs), out
 
 

@@ -38,11 +38,12 @@ def decimate(mesh: Mesh, ratio: float) -> tuple[Mesh, np.ndarray]:
         size = np.exp(0.5 * (low + high))
         rep = _representatives(vertices, size)
         kept = _surviving(rep[tris])
-        if best is None or abs(kept.sum() - target) < abs(best[1].sum() - target):
-            best = (rep, kept)
-        low, high = (np.log(size), high) if kept.sum() > target else (low, np.log(size))
+        count = _distinct(rep[tris[kept]])  # layers collapsing onto each other count once
+        if best is None or abs(count - target) < abs(best[2] - target):
+            best = (rep, kept, count)
+        low, high = (np.log(size), high) if count > target else (low, np.log(size))
     assert best is not None
-    rep, kept = best
+    rep, kept, _ = best
     faces = rep[tris[kept]]
     uvs = tri_uvs[kept] if tri_uvs is not None else None
     return _compact(mesh.vertices, faces, uvs, mesh.uvs, np.arange(len(mesh.vertices)))
@@ -58,6 +59,11 @@ def _triangles(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None]:
         uvs = np.concatenate([np.asarray(mesh.face_uvs)[:, p] for p in pick])
     keep = _surviving(tris)
     return tris[keep], (uvs[keep] if uvs is not None else None)
+
+
+def _distinct(tris: np.ndarray) -> int:
+    """How many different triangles (as vertex sets) ``tris`` (T, 3) holds."""
+    return len(np.unique(np.sort(tris, axis=1), axis=0)) if len(tris) else 0
 
 
 def _surviving(tris: np.ndarray) -> np.ndarray:
