@@ -1,13 +1,15 @@
-"""Exporting a dressed, animated human: baked garment corrections against plain skinning.
+"""Exporting a dressed, animated human: compact baked garment corrections against plain skinning.
 
     .venv/bin/python bench/export_bake.py [--seconds 10] [--fps 30] [--wear tshirt,jeans,...]
+    .venv/bin/python bench/export_bake.py --clip CLIP.bvh   # e.g. CMU 01_01 (2,752 frames)
 
-One dressed body (the default human, game_engine rig), the built-in walk. In the same run:
-the plain skinned GLB (``resolve_garments=False``) and the baked one (one morph target per
-corrected frame per garment, ``avatar.clothes.bake``): export time, the bake's time per
-frame (``Outfit.frame(exact=True)`` alone as the anchor), file sizes, how many frames got a
-target and how many garment vertices a target moves on average. Prints a table for
-docs/benchmarks.md.
+One dressed body (the default human, game_engine rig), the built-in walk or a BVH clip
+retargeted onto it. In the same run: the plain skinned GLB (``resolve_garments=False``) and
+the baked one (a few correction shapes per garment driven by per-frame weights,
+``avatar.clothes.bake``): export time, the bake's time per frame (``Outfit.frame(exact=True)``
+alone as the anchor), file sizes, correction shapes per garment, and the worst garment
+penetration played back from each file (morphs blended with the keyed weights, then the
+file's skin and animation: what a viewer shows). Prints a table for docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -26,11 +28,11 @@ def _arg(argv: list[str], name: str, default: str) -> str:
     return argv[argv.index(name) + 1] if name in argv else default
 
 
-def _frame_anchor(human, walk, frames: int) -> float:
+def _frame_anchor(human, clip, frames: int) -> float:
     """Seconds per ``Outfit.frame(exact=True)`` call (body skinning included), median."""
     from avatar.rig import kinematics, skinning
 
-    world = kinematics.forward(human.skeleton, walk.rotations[:frames], walk.translations[:frames])
+    world = kinematics.forward(human.skeleton, clip.rotations[:frames], clip.translations[:frames])
     matrices = kinematics.skinning_matrices(human.skeleton, world)
     times = []
     for t in range(frames):
@@ -41,18 +43,36 @@ def _frame_anchor(human, walk, frames: int) -> float:
     return float(np.median(times))
 
 
-def _targets(path: Path) -> tuple[int, int, float]:
-    """(garment parts with targets, targets, mean vertices moved per target) of a file."""
-    import pygltflib
+def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
+    """(worst depth (m) of a garment vertex inside the body over every frame, frames with
+    any vertex more than 1 mm inside), played back from the file alone."""
+    from avatar.geometry import collision
+    from avatar.io import gltf
+    from avatar.rig import kinematics, skinning
 
-    gltf = pygltflib.GLTF2().load(str(path))
-    counts = [
-        (gltf.accessors[t["POSITION"]].sparse.count if gltf.accessors[t["POSITION"]].sparse
-         else gltf.accessors[t["POSITION"]].count)
-        for m in gltf.meshes for t in (m.primitives[0].targets or [])
-    ]  # fmt: skip
-    parts = sum(1 for m in gltf.meshes if m.primitives[0].targets)
-    return parts, len(counts), float(np.mean(counts)) if counts else 0.0
+    file = gltf.read(path)
+    name, clip = next(iter(file.animations.items()))
+    keyed = file.morph_weights.get(name, {})
+    world = kinematics.forward(file.skeleton, clip.rotations, clip.translations)
+    parts = {p.name: p for p in file.parts}
+    garments = [p for n, p in parts.items() if n not in ("body", "eyes") and "_LOD" not in n]
+    worst, bad = 0.0, 0
+    for t in range(clip.frames):
+        matrices = kinematics.skinning_matrices(file.skeleton, world[t : t + 1])[0]
+        skin = skinning.SkinWeights(*parts["body"].skin)
+        body = skinning.linear_blend(parts["body"].mesh.vertices, skin, matrices)
+        frame_worst = 0.0
+        for g in garments:
+            rest = g.mesh.vertices.astype(np.float64)
+            for k, delta in enumerate(g.morphs.values()):
+                if g.name in keyed and keyed[g.name][t, k]:
+                    rest = rest + keyed[g.name][t, k] * delta
+            posed = skinning.linear_blend(rest, skinning.SkinWeights(*g.skin), matrices)
+            frame_worst = max(
+                frame_worst, float(collision.penetration(body, faces, posed)[1].max())
+            )
+        worst, bad = max(worst, frame_worst), bad + (frame_worst > 1e-3)
+    return worst, bad
 
 
 def main(argv: list[str]) -> None:
@@ -61,23 +81,31 @@ def main(argv: list[str]) -> None:
     seconds, fps = float(_arg(argv, "--seconds", "10")), float(_arg(argv, "--fps", "30"))
     wear = _arg(argv, "--wear", WEAR).split(",")
     human = avatar.Human({}, rig="game_engine").dressed(*wear)
-    walk = human.walk(seconds=seconds, fps=fps)
+    if "--clip" in argv:
+        source = Path(_arg(argv, "--clip", ""))
+        clip, _ = human.retarget(*avatar.load_bvh(source))
+        label = f"{source.stem}: {clip.frames} frames at {clip.fps:g} fps"
+    else:
+        clip = human.walk(seconds=seconds, fps=fps)
+        label = f"walk: {clip.frames} frames ({seconds:g} s at {fps:g} fps)"
     start = time.perf_counter()
     human.outfit  # noqa: B018 -- dress once, outside both timings
     dress = time.perf_counter() - start
-    anchor = _frame_anchor(human, walk, min(20, walk.frames))
+    anchor = _frame_anchor(human, clip, min(20, clip.frames))
+    faces = human.model.base.faces[human.model.base.face_groups["body"]]
     with tempfile.TemporaryDirectory() as tmp:
         rows = {}
-        for label, resolve in (("plain", False), ("baked", True)):
-            path = Path(tmp) / f"{label}.glb"
+        for name, resolve in (("plain", False), ("baked", True)):
+            path = Path(tmp) / f"{name}.glb"
             start = time.perf_counter()
-            avatar.save(human, path, walk, resolve_garments=resolve)
-            rows[label] = (time.perf_counter() - start, path.stat().st_size, _targets(path))
-    (plain_s, plain_b, _), (baked_s, baked_b, counts) = rows["plain"], rows["baked"]
-    parts, targets, moved = counts
-    per_frame = (baked_s - plain_s) / walk.frames
-    print(f"{walk.frames} frames ({seconds:g} s at {fps:g} fps), garments: {', '.join(wear)}; "
-          f"dressing {dress:.2f} s")  # fmt: skip
+            avatar.save(human, path, clip, resolve_garments=resolve)
+            seconds_taken = time.perf_counter() - start
+            shapes = {p.name: len(p.morphs) for p in avatar.load(path).parts[2:]}
+            rows[name] = (seconds_taken, path.stat().st_size, shapes,
+                          _played_penetration(path, faces))  # fmt: skip
+    (plain_s, plain_b, _, plain_in), (baked_s, baked_b, shapes, baked_in) = rows.values()
+    per_frame = (baked_s - plain_s) / clip.frames
+    print(f"{label}; garments: {', '.join(wear)}; dressing {dress:.2f} s")
     print("| measure | plain skinned | baked | ratio |")
     print("| --- | ---: | ---: | ---: |")
     print(f"| export time | {plain_s:.1f} s | {baked_s:.1f} s | {baked_s / plain_s:.1f}x |")
@@ -86,10 +114,12 @@ def main(argv: list[str]) -> None:
           f"{per_frame / anchor:.2f}x {exact} |")  # fmt: skip
     print(f"| GLB size | {plain_b / 1e6:.2f} MB | {baked_b / 1e6:.2f} MB | "
           f"{baked_b / plain_b:.2f}x |")  # fmt: skip
-    print(f"| morph targets | 0 | {targets} on {parts} garments | "
-          f"{targets / max(parts, 1) / walk.frames:.0%} of frames |")  # fmt: skip
-    print(f"| vertices moved per target (mean) | | {moved:.0f} | "
-          f"{(baked_b - plain_b) / max(targets, 1) / 1e3:.1f} kB/target |")  # fmt: skip
+    print(f"| correction shapes (incl. offset) | 0 | "
+          f"{', '.join(f'{k} {v}' for k, v in shapes.items())} | |")  # fmt: skip
+    print(f"| worst garment depth inside the body, played back | {plain_in[0] * 1e3:.1f} mm | "
+          f"{baked_in[0] * 1e3:.1f} mm | |")  # fmt: skip
+    print(f"| frames with a garment vertex > 1 mm inside | {plain_in[1]} | {baked_in[1]} | "
+          f"of {clip.frames} |")  # fmt: skip
 
 
 if __name__ == "__main__":

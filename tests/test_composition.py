@@ -150,3 +150,30 @@ def test_the_extension_path_needs_no_pygltflib_nor_tqdm(model):
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
                          text=True).stdout  # fmt: skip
     assert out.strip() == "3"
+
+
+def test_create_takes_asset_folders_and_game_engine_options(fixtures, tmp_path, model):
+    """`create --folder DIR --wear NAME`: a MakeHuman asset found by name in the folder,
+    its covered skin hidden (MakeHuman's default) unless --keep-body; the .mhm names it as
+    MakeHuman does and re-creates the same character; the GLB options reach the file."""
+    from avatar import cli
+    from avatar.io import gltf, mhm
+
+    folder = str(fixtures / "makehuman")
+    out = tmp_path / "suit.mhm"
+    assert cli.main(["create", "--folder", folder, "--wear", "female_casualsuit01",
+                     "--wear", "short02", "-o", str(out)]) == 0  # fmt: skip
+    lines = mhm.dumps(mhm.read(out)).splitlines()
+    assert "clothes female_casualsuit01 a8b0e841-144b-4f03-8b9e-ea8fdce8c863" in lines
+    assert "hair short02 c104cd4a-1edc-43f9-8b94-f63345a44638" in lines
+    glb = tmp_path / "suit.glb"
+    assert cli.main(["create", str(out), "--folder", folder, "--max-influences", "4",
+                     "--texture-size", "128", "--lods", "1", "-o", str(glb)]) == 0  # fmt: skip
+    parts = {p.name: p for p in gltf.read(glb).parts}
+    assert {"female_casualsuit01", "short02", "body_LOD1", "short02_LOD1"} <= set(parts)
+    assert len(parts["body"].mesh.vertices) < 13380  # covered skin left out
+    assert max(parts["short02"].material.base_color_texture.shape[:2]) <= 128
+    kept = tmp_path / "kept.glb"
+    assert cli.main(["create", str(out), "--folder", folder, "--keep-body",
+                     "-o", str(kept)]) == 0  # fmt: skip
+    assert len(gltf.read(kept).parts[0].mesh.vertices) == 13380

@@ -17,6 +17,7 @@ from avatar.body.model import BodyModel
 from avatar.cli import motion, paths
 from avatar.cli.assignments import parse_assignments, parse_measurements
 from avatar.clothes import library
+from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
 from avatar.motion.procedural import MOTIONS
 from avatar.rig.skeleton import Animation
@@ -55,9 +56,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--motion", metavar="CLIP.bvh",
                    help="BVH clip to retarget onto the human, or: walk")  # fmt: skip
     motion.add_motion_arguments(p)
+    p.add_argument("--folder", action="append", default=[], metavar="DIR",
+                   help="a MakeHuman/MPFB asset folder (or user garments): its garments, hair, "
+                   "eyebrows, eyelashes, skins and poses can be worn, named in the .mhm "
+                   "file or found by --wear NAME; repeatable")  # fmt: skip
     p.add_argument("--hide-covered", action="store_true",
-                   help="glTF: leave out skin that garments cover entirely "
-                   "(default: keep it)")  # fmt: skip
+                   help="leave out skin that any garment covers entirely, built-ins too "
+                   "(MakeHuman garments hide it by default, as in MakeHuman)")  # fmt: skip
+    p.add_argument("--keep-body", action="store_true",
+                   help="keep the whole body under every garment (e.g. for cloth "
+                   "simulation)")  # fmt: skip
+    p.add_argument("--max-influences", type=int, choices=(4, 8), default=8,
+                   help="glTF: joints per vertex (4 for three.js and engines that read "
+                   "one JOINTS set; default 8)")  # fmt: skip
+    p.add_argument("--texture-size", type=int, metavar="PX",
+                   help="glTF/OBJ: longest texture side, e.g. 512, 1024, 2048 (default: each "
+                   "part's textures sized to its surface)")  # fmt: skip
+    p.add_argument("--lods", type=int, default=0, metavar="N",
+                   help="glTF: N decimated levels of the body and garments (<name>_LOD1.., "
+                   "each half the triangles of the one before)")  # fmt: skip
     p.add_argument("--expressions", action="store_true",
                    help="glTF: include the 52 ARKit face units as morph targets")  # fmt: skip
     p.add_argument("--no-resolve-garments", dest="resolve_garments", action="store_false",
@@ -75,11 +92,15 @@ def run(args: argparse.Namespace) -> int:
     human = Human.from_recipe(_recipe(args, model), model)
     animation, name = _animation(human, args)
     path = export.save(human, args.output, animation, expressions=args.expressions,
-                       hide_covered=args.hide_covered, animation_name=name, rest=args.rest,
-                       resolve_garments=args.resolve_garments, progress=True)  # fmt: skip
+                       hide_covered=_hiding(args), animation_name=name, rest=args.rest,
+                       resolve_garments=args.resolve_garments, progress=True,
+                       max_influences=args.max_influences, texture_size=args.texture_size,
+                       lods=args.lods)  # fmt: skip
     log.info("wrote %s", path)
-    if args.render:
-        log.info("rendered %s", export.render(human, args.render, animation))
+    if args.render:  # the same parts as the file
+        picture = export.render(human, args.render, animation, hide_covered=_hiding(args),
+                                expressions=args.expressions)  # fmt: skip
+        log.info("rendered %s", picture)
     return 0
 
 
@@ -98,15 +119,24 @@ def _check_paths(args: argparse.Namespace) -> None:
 def _recipe(args: argparse.Namespace, model: BodyModel) -> Recipe:
     """The whole recipe from the options, every name checked, measurements solved."""
     for name in args.wear:  # fail early, naming the unknown garment, before any fitting
-        library.find_garment(name)
-    recipe = Recipe.from_mhm(args.character) if args.character else Recipe()
+        library.find_garment(name, args.folder)
+    recipe = Recipe.from_mhm(args.character, folders=args.folder) if args.character else Recipe()
     params = model.resolve(recipe.params | parse_assignments(args.set))
     if args.measure:
         wanted = parse_measurements(args.measure)
         params, got = measures.fit(model, wanted, params)
         log.info("measurements: %s", ", ".join(f"{k} {v * 100:.1f} cm" for k, v in got.items()))
     clothes = tuple(dict.fromkeys(recipe.clothes + tuple(args.wear)))
-    return replace(recipe, params=params, rig=args.rig or recipe.rig, clothes=clothes)
+    hide = recipe.hide_covered if _hiding(args) is None else _hiding(args)
+    folders = tuple(dict.fromkeys(recipe.folders + tuple(args.folder)))
+    return replace(recipe, params=params, rig=args.rig or recipe.rig, clothes=clothes,
+                   pose=args.pose or recipe.pose, hide_covered=hide,
+                   folders=folders)  # fmt: skip
+
+
+def _hiding(args: argparse.Namespace) -> bool | None:
+    """--hide-covered: True, --keep-body: False, neither: None (MakeHuman garments hide)."""
+    return True if args.hide_covered else (False if args.keep_body else None)
 
 
 def _animation(human: Human, args: argparse.Namespace) -> tuple[Animation | None, str | None]:
@@ -120,5 +150,12 @@ def _animation(human: Human, args: argparse.Namespace) -> tuple[Animation | None
         animation, _ = motion.on_floor(human.body, animation, args.keep_height)
         return animation, Path(args.motion).stem
     if args.pose:
-        return human.pose(args.pose, args.pose_folder), Path(args.pose).stem  # on the floor
+        return human.pose(args.pose, args.pose_folder + args.folder), Path(args.pose).stem
+    if human.recipe.pose:  # a .mhm's pose: MakeHuman names the file (standing01.bvh)
+        pose = human.recipe.pose
+        pose = pose if Path(pose).is_file() else Path(pose).stem
+        try:
+            return human.pose(pose, args.pose_folder + args.folder), Path(pose).stem
+        except AvatarError as exc:
+            log.warning("the character's pose is not applied: %s", exc)
     return None, None
