@@ -145,7 +145,7 @@ def _animation(human: Human, args: argparse.Namespace) -> tuple[Animation | None
         clip = MOTIONS[args.motion](human.skeleton, fps=args.fps or 30.0, body=human.body)
         return clip, args.motion
     if args.motion:
-        animation, report = motion.motion_for(human.skeleton, args.motion, args)
+        animation, report = motion.motion_for(human.skeleton, args.motion, args, human.body)
         log.info("%s", report.summary())
         animation, _ = motion.on_floor(human.body, animation, args.keep_height)
         return animation, Path(args.motion).stem

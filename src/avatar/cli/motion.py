@@ -16,7 +16,7 @@ from avatar.errors import AvatarError, ParameterError
 from avatar.human import Human
 from avatar.io import atomic, bvh
 from avatar.motion import floor, poselib, timing
-from avatar.motion.retarget import RetargetReport, retarget
+from avatar.motion.retarget import RetargetReport, retarget, with_stretch
 from avatar.rig.skeleton import Animation, Skeleton
 
 log = logging.getLogger(__name__)
@@ -85,11 +85,12 @@ def clip_paths(inputs: list[str]) -> list[Path]:
     return out
 
 
-def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
-               ) -> tuple[Animation, RetargetReport]:  # fmt: skip
-    """Retarget one clip onto ``target`` with the options of ``add_motion_arguments``."""
+def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace,
+               body: Body | None = None) -> tuple[Animation, RetargetReport]:  # fmt: skip
+    """Retarget one clip onto ``target`` with the options of ``add_motion_arguments``; with
+    the ``body`` on it, the report also says how the motion stretches its skin."""
     source, animation = bvh.load(paths.input_file(clip, "clip"))
-    return retarget(
+    animation, report = retarget(
         source,
         animation,
         target,
@@ -99,6 +100,7 @@ def motion_for(target: Skeleton, clip: str | Path, args: argparse.Namespace
         in_place=args.in_place,
         fix_feet=not args.no_foot_fix,
     )
+    return animation, report if body is None else with_stretch(report, body, animation)
 
 
 def run_retarget(args: argparse.Namespace) -> int:
@@ -135,7 +137,7 @@ def run_retarget(args: argparse.Namespace) -> int:
 def _retarget_one(human: Human, target: Skeleton, clip: Path, out: Path,
                   args: argparse.Namespace) -> dict:  # fmt: skip
     """One clip of ``run_retarget``: its BVH written, its line printed; its report row."""
-    animation, report = motion_for(target, clip, args)
+    animation, report = motion_for(target, clip, args, human.body)
     animation, ground = on_floor(human.body, animation, args.keep_height)
     skeleton = target
     if args.rest:

@@ -28,7 +28,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from avatar.body.shaped import Body
-from avatar.motion import bonemap, calibrate, contacts, floor, geometry, metrics, timing
+from avatar.motion import (
+    bonemap,
+    calibrate,
+    contacts,
+    deformation,
+    floor,
+    geometry,
+    metrics,
+    timing,
+)
 from avatar.motion.pairs import Pair, make_pairs, segment_rest, segments
 from avatar.rig import quaternion
 from avatar.rig.kinematics import levels, rest_quaternions, world_pose
@@ -156,10 +165,21 @@ def retarget(
 
 def _settle(body: Body, animation: Animation, report: RetargetReport):
     """The animation settled on the body's skin (planted feet on the floor, no vertex
-    under it: ``floor.settle_body``) and the report with how it meets the floor now."""
+    under it: ``floor.settle_body``) and the report with how it meets the floor now and,
+    when measured, how it stretches the skin."""
     ground = floor.measure_body(body, animation)
     animation, shift = floor.settle_body(body, animation, report=ground)
-    return animation, replace(report, floor=ground.shifted(shift))
+    return animation, with_stretch(replace(report, floor=ground.shifted(shift)), body, animation)
+
+
+def with_stretch(report: RetargetReport, body: Body, animation: Animation) -> RetargetReport:
+    """``report`` with its quality's skin stretch of ``animation`` on ``body``
+    (``deformation.measure``: per bone, the face, the eyes; bones over their limit are
+    ``Quality.deformed``). Unchanged when the quality was not measured."""
+    if report.quality is None:
+        return report
+    stretch = deformation.measure(body, animation)
+    return replace(report, quality=report.quality.with_stretch(stretch))
 
 
 def _transfer(pairs: list[Pair], align: np.ndarray, src: _Source, src_seg: np.ndarray,
