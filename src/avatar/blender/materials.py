@@ -232,11 +232,17 @@ def image_from_array(name: str, array: np.ndarray, non_color: bool = False) -> b
     """A packed Blender image from (H, W) or (H, W, 1|2|3|4) uint8 or float 0..1, row 0 on top.
 
     non_color: data textures (normal, roughness) that must not be colour-managed.
-    The image is packed into the .blend so saving or exporting keeps it.
+    The image is packed into the .blend so saving or exporting keeps it. An image whose
+    alpha is 1 everywhere is made (and packed) without an alpha channel: importers (FBX's)
+    wire a texture's alpha to the BSDF whenever the file has one, which turned the opaque
+    skin into a cut-out on re-import.
     """
     rgba = to_rgba(array)
     height, width = rgba.shape[:2]
-    image = bpy.data.images.new(name, width, height, alpha=True)
+    opaque = bool(np.all(rgba[..., 3] >= 1.0))
+    image = bpy.data.images.new(name, width, height, alpha=not opaque)
+    if opaque:
+        image.alpha_mode = "NONE"
     if non_color:  # before the pixels: changing a generated image's colour space clears them
         image.colorspace_settings.name = "Non-Color"
     image.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).ravel())  # Blender: bottom-up
