@@ -225,3 +225,21 @@ def test_ray_cluster_on_loopback_renders_the_same_samples(dataset, tmp_path):
             assert (clean / "samples" / f"{i:08d}" / name).read_bytes() == \
                 (out / "samples" / f"{i:08d}" / name).read_bytes(), (i, name)  # fmt: skip
     shutil.rmtree(out, ignore_errors=True)
+
+
+def test_loader_returns_numpy_arrays(dataset):
+    from avatar.dataset.loader import AvatarDataset
+
+    c, out = dataset
+    data = AvatarDataset(out)
+    assert len(data) == 3
+    s = data[1]
+    h, w = 80, 96
+    assert s["rgb"].shape == (h, w, 3) and s["rgb"].dtype == np.uint8
+    assert s["depth"].shape == (h, w) and s["normals"].shape == (h, w, 3)
+    assert s["instances"].dtype == np.uint16 and s["parts"].shape == (h, w)
+    assert s["keypoints_2d"].shape[1:] == (17, 3) and s["K"].shape == (3, 3)
+    lengths = np.linalg.norm(s["normals"][s["instances"] > 0], axis=-1)
+    np.testing.assert_allclose(lengths, 1.0, atol=1e-3)
+    with pytest.raises(IndexError):
+        data[3]

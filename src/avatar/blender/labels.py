@@ -93,7 +93,7 @@ class Stage:
             floor.data.materials.append(self.floor_material)
         add_camera(camera, scene=scene)
         _add_light(scene, light)
-        _set_world(scene, background)
+        _set_world(scene, background, light if light.get("kind") == "sky" else None)
 
     def _material(self, part: MeshPart) -> bpy.types.Material:
         key = id(part.material)
@@ -225,7 +225,7 @@ def _add_light(scene: bpy.types.Scene, light: dict) -> None:
     scene.collection.objects.link(obj)
 
 
-def _set_world(scene: bpy.types.Scene, background: dict) -> None:
+def _set_world(scene: bpy.types.Scene, background: dict, sky: dict | None = None) -> None:
     """World light and backdrop: a plain colour, a procedural gradient of noise, Blender's
     sky texture (light kind "sky"), or an HDRI."""
     world = scene.world or bpy.data.worlds.new("World")
@@ -240,7 +240,14 @@ def _set_world(scene: bpy.types.Scene, background: dict) -> None:
     colour = tuple(background.get("colour", (0.4, 0.4, 0.45)))
     bg.inputs["Strength"].default_value = 0.8
     kind = background.get("kind", "solid")
-    if kind == "hdri" and background.get("image"):
+    if sky is not None and kind != "hdri":  # Blender's physical sky lights the scene
+        texture = tree.nodes.new("ShaderNodeTexSky")
+        if hasattr(texture, "sun_elevation"):
+            texture.sun_elevation = math.radians(float(sky.get("elevation_deg", 45.0)))
+            texture.sun_rotation = math.radians(float(sky.get("azimuth_deg", 0.0)))
+        tree.links.new(texture.outputs["Color"], bg.inputs["Color"])
+        bg.inputs["Strength"].default_value = 0.07 * float(sky.get("strength", 1.0))
+    elif kind == "hdri" and background.get("image"):
         env = tree.nodes.new("ShaderNodeTexEnvironment")
         env.image = bpy.data.images.load(str(background["image"]), check_existing=True)
         tree.links.new(env.outputs["Color"], bg.inputs["Color"])

@@ -49,7 +49,7 @@ def render_sample(config: Config, index: int, out: str | Path) -> dict:
         _composite(tmp / "rgb.png", spec.background["image"])
     labels = stage.render_labels()
     K, w2c = intrinsics(spec.camera), world_to_camera(spec.camera)
-    records = annotate.annotate(posed, labels.instance, labels.depth, K, w2c)
+    records = annotate.annotate(posed, labels.instance, labels.depth, labels.part, K, w2c)
     _write_labels(tmp, labels, w2c)
     meta = _meta(config, spec, posed, records, K, w2c, labels)
     store.write_json(tmp / "meta.json", meta)
