@@ -4,9 +4,11 @@
 
 Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
 from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``,
-download the binary wheels of the dependencies Blender lacks (SciPy, pykdtree for the
-clothes' searches, and Pillow for garment textures; Blender ships numpy, and pygltflib/tqdm
-are imported only by glTF export and the CLI) for the target platform and
+download the wheels of the dependencies Blender lacks (SciPy, pykdtree for the clothes'
+searches, Pillow for garment textures, and tqdm, which the garment bake of Apply (Motion)
+imports; Blender ships numpy, and pygltflib is imported only by glTF export and the CLI,
+which the add-on never calls: tests/blender/test_extension_envs.py runs it with pygltflib
+blocked) for the target platform and
 Blender's Python, list them in the manifest, then run Blender's own ``blender_ext.py build``
 and ``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
 (``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
@@ -104,8 +106,7 @@ def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Pat
     from importlib.metadata import version
 
     before = set(folder.glob("*.whl"))
-    for packages, required in (([f"scipy=={version('scipy')}", f"pillow=={version('pillow')}"],
-                                True), ([f"pykdtree=={version('pykdtree')}"], False)):  # fmt: skip
+    for packages, required in bundled_requirements(version):
         try:
             _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
                  "--only-binary=:all:", "--python-version", python, "--platform",
@@ -115,6 +116,16 @@ def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Pat
                 raise
             print(f"build: no {packages[0]} wheel for {platform}: SciPy's k-d tree is used")
     return sorted(set(folder.glob("*.whl")) - before)
+
+
+def bundled_requirements(version) -> list[tuple[list[str], bool]]:
+    """(pip requirements, required?) of the wheels the zip carries, pinned to the versions
+    installed here (``version``: importlib.metadata.version). tqdm is pure Python."""
+    return [
+        ([f"scipy=={version('scipy')}", f"pillow=={version('pillow')}"], True),
+        ([f"tqdm=={version('tqdm')}"], True),
+        ([f"pykdtree=={version('pykdtree')}"], False),
+    ]
 
 
 PIP_PLATFORMS = {  # Blender platform name -> pip platform tag
