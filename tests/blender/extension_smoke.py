@@ -45,13 +45,15 @@ def main() -> int:
     print("blender", bpy.app.version_string)
     install(bpy, args.zip)
     from avatar.blender import action, armature, live, mesh
+    from avatar.body.shaped import PART_GROUPS
     from avatar.human import Human
 
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
     assert bpy.ops.avatar.create_human() == {"FINISHED"}
     root = bpy.context.view_layer.objects.active
-    assert set(live.part_objects(root)) == {"body", "eyes", "hair-short", "eyebrows", "eyelashes"}
+    got = set(live.part_objects(root))
+    assert got == {*PART_GROUPS, "hair-short", "eyebrows", "eyelashes"}, (root.name, got)
     print("create ok")
     root.avatar.weight = 0.8
     root.avatar.african = 0.5

@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 from bridge_fixtures import box_mesh
 
+from avatar.body.shaped import PART_GROUPS
+
 ROOT = Path(__file__).resolve().parents[2]
 FIXTURES = Path(os.environ.get("AVATAR_FIXTURES", ROOT.parent / "shared" / "fixtures"))
 WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
@@ -53,7 +55,7 @@ def test_unrigged_characters_have_the_body_as_root(empty_scene, assets):
 
     built = character.create({"params": {}, "clothes": ["eyebrows"]}, rigged=False)
     assert built.armature is None and built.root.type == "MESH"
-    assert set(live.part_objects(built.root)) == {"body", "eyes", "eyebrows"}
+    assert set(live.part_objects(built.root)) == {*PART_GROUPS, "eyebrows"}
     live.set_params(built.root, {"weight": 0.9})
     assert json.loads(built.root["avatar_recipe"])["params"]["weight"] == 0.9
 
@@ -111,7 +113,7 @@ def test_motion_is_applied_and_survives_update(empty_scene, assets):
     again = character.update(moved.root, {"params": {"height": 0.9}, "clothes": ["eyebrows"]})
     assert json.loads(again.root["avatar_motion"]) == spec  # the motion is re-applied
     assert again.root.animation_data.action is not None
-    assert set(live.part_objects(again.root)) == {"body", "eyes", "eyebrows"}
+    assert set(live.part_objects(again.root)) == {*PART_GROUPS, "eyebrows"}
 
 
 def test_a_failed_motion_never_deletes_the_character(empty_scene, assets, tmp_path):

@@ -32,6 +32,7 @@ from avatar.blender import live
 from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
 from avatar.blender import scene as stage
+from avatar.body.shaped import PART_GROUPS
 from avatar.clothes import binder
 from avatar.clothes import library as clothes_library
 from avatar.errors import AvatarError
@@ -99,7 +100,7 @@ def _restyle(root: bpy.types.Object, recipe: Recipe) -> stage.CharacterObjects:
         for obj in added:
             _delete_objects([obj])
         raise
-    stale = [o for n, o in parts.items() if n not in ("body", "eyes") and n not in worn]
+    stale = [o for n, o in parts.items() if n not in PART_GROUPS and n not in worn]
     _delete_objects(stale)
     live.write(root, geo)
     live.refresh_materials(root, human)

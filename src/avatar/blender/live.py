@@ -163,7 +163,7 @@ def _parts(human: Human, geo: Geometry) -> list[tuple[MeshPart, Mesh]]:
     for part in PART_GROUPS:
         index = _part_index(geo.body.model, part)
         skin = weights.subset(index)
-        mesh = human.part(part) if part == "eyes" else _body_mesh(geo)
+        mesh = _body_mesh(geo) if part == "body" else human.part(part)
         out.append((MeshPart(part, mesh, _body_material(human, part),
                              (skin.indices, skin.weights)), mesh))  # fmt: skip
     for fitted in geo.outfit or ():
