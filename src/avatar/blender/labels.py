@@ -76,11 +76,12 @@ class Stage:
         """Replace the scene's objects by ``items``, the camera, the light and the world."""
         _clear_objects()
         scene = bpy.context.scene
-        used = set()
+        used: set[str] = set()
         for item in items:
             obj = mesh_bridge.new_mesh_object(item.part.name, item.part.mesh, scene.collection)
-            obj.data.materials.append(self._material(item.part))
-            used.add(id(item.part.material))
+            mat = self._material(item.part)
+            obj.data.materials.append(mat)
+            used.add(mat.name_full)
             obj.pass_index = int(item.instance)
             values = np.zeros(len(item.part.mesh.faces), np.int32)
             if item.face_parts is not None:
@@ -103,10 +104,15 @@ class Stage:
                                                                            part.name))
         return self.materials[key][1]
 
-    def _drop_unused(self, used: set[int]) -> None:
+    def _drop_unused(self, used: set[str]) -> None:
+        """Forget records whose material this sample did not use and remove those materials
+        (and their images) from Blender; the bridge may give equal records one material."""
         for key in list(self.materials):
-            if key not in used:
-                _, mat = self.materials.pop(key)
+            if self.materials[key][1].name_full not in used:
+                del self.materials[key]
+        kept = {mat.name_full for _, mat in self.materials.values()}
+        for mat in list(bpy.data.materials):
+            if mat.users == 0 and mat.name_full not in kept and not mat.use_fake_user:
                 images = [n.image for n in mat.node_tree.nodes if getattr(n, "image", None)]
                 bpy.data.materials.remove(mat)
                 for image in images:

@@ -68,8 +68,8 @@ pose_probability = 0.2
 poses = ["a-pose", "t-pose"]
 
 [camera]
-focal_mm = [30.0, 60.0]          # lens on a 36 mm sensor
-distance = [2.5, 4.5]            # metres from the person's centre
+focal_mm = [28.0, 45.0]          # lens on a 36 mm sensor
+distance = [3.5, 6.0]            # metres from the look-at point (about hip height)
 elevation_deg = [-5.0, 25.0]
 azimuth_deg = [-180.0, 180.0]    # 0 = in front of the person
 look_at_jitter = 0.15            # metres of random offset of the look-at point
@@ -168,6 +168,9 @@ class Config:
     source: str = ""  # the config file, for messages
 
 
+_DEFAULTS: dict[str, Any] = tomllib.loads(EXAMPLE)
+_DEFAULTS["bodies"] = {**_DEFAULTS["bodies"], "cupsize": [0.0, 1.0], "firmness": [0.0, 1.0]}
+
 MACRO_KEYS = ("gender", "age", "muscle", "weight", "height", "proportions", "cupsize",
               "firmness")  # fmt: skip
 
@@ -191,6 +194,14 @@ def loads(text: str, source: str = "<config>", **overrides: Any) -> Config:
         line = int(getattr(exc, "lineno", 0) or _line_of_message(str(exc)))
         raise FormatError(source, line, f"invalid TOML: {exc}") from None
     v = _Validator(text, source, data)
+    for name, table in data.items():  # unknown keys are errors before defaults fill in
+        if isinstance(table, dict) and name in _DEFAULTS:
+            v.only_keys(name, set(table), set(_DEFAULTS[name]))
+    # Every key missing from the file takes EXAMPLE's value (varied bodies, outfits, ...).
+    data = {**_DEFAULTS, **{k: ({**_DEFAULTS[k], **t} if isinstance(t, dict) and
+                                isinstance(_DEFAULTS.get(k), dict) else t)
+                            for k, t in data.items()}}  # fmt: skip
+    v.data = data
     render = v.section("render", {"resolution", "engine", "samples", "recycle_every"})
     bodies = v.section("bodies", {*MACRO_KEYS, "ethnicity", "attributes_sigma", "rig"})
     clothes = v.section("clothes", {"tops", "bottoms", "dress_probability", "dresses", "shoes",

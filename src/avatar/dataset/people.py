@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES, BodyModel
-from avatar.body.shaped import default_body, part_vertices
+from avatar.body.shaped import PART_GROUPS, default_body, part_vertices
 from avatar.dataset.sampling import WALK_FPS, WALK_SECONDS, Person
 from avatar.human import Human, Recipe
 from avatar.io import bvh
@@ -102,10 +102,11 @@ def pose_person(person: Person, model: BodyModel | None = None) -> PosedPerson:
     place = _placement(person)
     rest_parts = human.parts()
     parts = []
-    for part in rest_parts[:2]:  # body, eyes: the posed base-mesh vertices of the part
+    body_parts = len(PART_GROUPS)  # body, eyes, teeth, tongue: posed base-mesh vertices
+    for part in rest_parts[:body_parts]:
         index = human.part_vertices(part.name)
         parts.append(_moved(part, posed[index], place))
-    for part, vertices in zip(rest_parts[2:], garments, strict=True):
+    for part, vertices in zip(rest_parts[body_parts:], garments, strict=True):
         parts.append(_moved(part, vertices, place))
     joints = _apply(place, world[0][:, :3, 3])
     keypoints, depth = _keypoints(human, posed, world[0][:, :3, 3])
@@ -122,8 +123,8 @@ def _face_parts(human: Human, posed: np.ndarray, garments: list[np.ndarray]) -> 
     skin = posed[:BODY_VERTICES]
     labels = vertex_parts(model)
     out = [body_face_parts(model)]
-    eyes = human.part("eyes")
-    out.append(np.full(len(eyes.faces), PARTS.index("head") + 1, np.int32))
+    for name in list(PART_GROUPS)[1:]:  # eyes, teeth, tongue: the head
+        out.append(np.full(len(human.part(name).faces), PARTS.index("head") + 1, np.int32))
     if garments:
         tree = cKDTree(skin)
         for fitted, vertices in zip(human.outfit.garments, garments, strict=True):

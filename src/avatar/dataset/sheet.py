@@ -80,3 +80,44 @@ def sheet(out: Path, ids: Sequence[int], path: Path, cell: int = 192) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     sheet_img.save(path)
     return path
+
+
+def conventions(out: Path, index: int, path: Path, scale: int = 3) -> Path:
+    """A sample's RGB with its conventions drawn on it: the pixel axes u (right) and v
+    (down) from pixel (0, 0), the principal point, the world axes X, Y, Z (red, green,
+    blue, 0.5 m) at the origin projected through K and world_to_camera, and each person's
+    3D joints projected (dots)."""
+    from PIL import Image, ImageDraw
+
+    from avatar.camera import project
+
+    folder = store.sample_dir(out, index)
+    meta = json.loads((folder / "meta.json").read_text())
+    K, w2c = np.array(meta["K"]), np.array(meta["world_to_camera"])
+    rgb = Image.open(folder / "rgb.png").convert("RGB")
+    image = rgb.resize((rgb.width * scale, rgb.height * scale), Image.Resampling.LANCZOS)
+    d = ImageDraw.Draw(image)
+
+    def at(u: float, v: float) -> tuple[float, float]:  # OpenCV pixel -> drawn position
+        return ((u + 0.5) * scale, (v + 0.5) * scale)
+
+    d.line([at(0, 0), at(40, 0)], fill=(255, 255, 255), width=2)
+    d.line([at(0, 0), at(0, 40)], fill=(255, 255, 255), width=2)
+    d.text(at(42, -4), "u (x)", fill=(255, 255, 255))
+    d.text(at(2, 42), "v (y)", fill=(255, 255, 255))
+    d.text(at(3, 3), "(0, 0): centre of the top-left pixel", fill=(255, 255, 255))
+    cx, cy = K[0, 2], K[1, 2]
+    d.ellipse([*at(cx - 1.5, cy - 1.5), *at(cx + 1.5, cy + 1.5)], outline=(255, 255, 0))
+    d.text(at(cx + 3, cy + 2), "(cx, cy)", fill=(255, 255, 0))
+    axes = project(np.array([[0, 0, 0], [0.5, 0, 0], [0, 0.5, 0], [0, 0, 0.5]]), K, w2c)
+    for end, colour, name in zip(axes[1:], [(255, 60, 60), (60, 255, 60), (80, 140, 255)],
+                                 "XYZ", strict=True):  # fmt: skip
+        d.line([at(*axes[0][:2]), at(*end[:2])], fill=colour, width=3)
+        d.text(at(end[0] + 2, end[1]), f"world {name}", fill=colour)
+    for person in meta["people"]:
+        for u, v, z in person["joints_2d"]:
+            if z > 0:
+                d.point(at(u, v), fill=(255, 0, 255))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    image.save(path)
+    return path

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar.body.shaped import PART_GROUPS
 from avatar.camera import intrinsics, world_to_camera
 from avatar.dataset import annotate, people, sampling, store
 from avatar.dataset.config import Config, avatar_version
@@ -96,7 +97,7 @@ def _meta(config: Config, spec, posed, records, K, w2c, labels) -> dict:
                             "counts": encoded["counts"].decode("ascii")}  # fmt: skip
         coco_kps = [[float(u + 0.5), float(v + 0.5), int(vis)] if vis else [0.0, 0.0, 0]
                     for u, v, vis in rec["keypoints"]]  # fmt: skip
-        garments = [part.name for part in person.parts[2:]]
+        garments = [part.name for part in person.parts[len(PART_GROUPS):]]
         persons.append({
             "recipe": person.recipe,
             "motion": {"source": person.person.motion, "frame": person.person.frame},

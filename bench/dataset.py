@@ -1,0 +1,120 @@
+"""Dataset throughput and memory, against anchors measured in the same run.
+
+    python bench/dataset.py [--count 16] [--resolution 256] [--samples 16] [--rss 0]
+
+1. label overhead: samples/s with every label against the anchor, a bare Cycles render of
+   the same scenes (same people, camera, lights; RGB only), on one worker in-process;
+2. workers: 1 -> 2 local worker processes (efficiency = rate(2) / (2 * rate(1)));
+3. engines: local vs Ray (a local cluster), same samples;
+4. --rss N: the worker's resident memory over N samples (one process, no recycling), the
+   curve printed every 10 samples: it should stay within 10% of its value after 50.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from avatar.dataset import config as dataset_config
+from avatar.dataset import people, runner, sampling, worker
+
+
+def _config(args, count: int, extra: str = "") -> dataset_config.Config:
+    text = dataset_config.EXAMPLE + extra
+    return dataset_config.loads(text, "bench.toml", count=count, samples=args.samples,
+                                resolution=(args.resolution, args.resolution))  # fmt: skip
+
+
+def bare_vs_labelled(args, folder: Path) -> tuple[float, float]:
+    """(bare s/sample, labelled s/sample) in this process, same scenes, alternating."""
+    from avatar.blender import labels as blender_labels
+
+    c = _config(args, args.count)
+    bare = labelled = 0.0
+    worker.render_sample(c, args.count, folder)  # warm: garments built, Blender started
+    for i in range(args.count):
+        for step in ((0, 1) if i % 2 else (1, 0)):  # alternate which one meets warm caches
+            start = time.perf_counter()
+            if step:
+                worker.render_sample(c, i, folder)  # everything: people, RGB, labels, files
+                labelled += time.perf_counter() - start
+                continue
+            spec = sampling.sample(c, i)
+            posed = [people.pose_person(p) for p in spec.people]
+            items = [blender_labels.Item(part, 1) for person in posed for part in person.parts]
+            stage = worker._STAGE[0]
+            stage.build(items, spec.camera, spec.light, spec.background)
+            stage.render_rgb(folder / "bare.png", spec.engine, spec.samples, False)
+            bare += time.perf_counter() - start
+    return bare / args.count, labelled / args.count
+
+
+def rate(args, workers: int, engine: str, folder: Path) -> float:
+    c = _config(args, args.count)
+    shutil.rmtree(folder, ignore_errors=True)
+    start = time.perf_counter()
+    report = runner.run(c, folder, workers=workers, engine=engine)
+    assert not report.failed, report.failed
+    return args.count / (time.perf_counter() - start)
+
+
+def rss_curve(args, folder: Path) -> list[tuple[int, float]]:
+    """(samples done, RSS MB) of this process rendering ``args.rss`` samples."""
+    c = _config(args, args.rss)
+    out = []
+    for i in range(args.rss):
+        worker.render_sample(c, i, folder)
+        if (i + 1) % 10 == 0:
+            out.append((i + 1, _rss_mb()))
+            print(f"  {i + 1:5d} samples: RSS {out[-1][1]:.0f} MB", flush=True)
+    return out
+
+
+def _rss_mb() -> float:
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=12)
+    parser.add_argument("--resolution", type=int, default=256)
+    parser.add_argument("--samples", type=int, default=16)
+    parser.add_argument("--rss", type=int, default=0, help="samples for the memory curve")
+    parser.add_argument("--skip-ray", action="store_true")
+    args = parser.parse_args()
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        print(f"{args.count} samples, {args.resolution}x{args.resolution}, {args.samples} spp, "
+              f"{os.cpu_count()} CPUs, Python {sys.version.split()[0]}")  # fmt: skip
+        bare, labelled = bare_vs_labelled(args, root / "inproc")
+        print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
+              f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}%")
+        one = rate(args, 1, "local", root / "w1")
+        two = rate(args, 2, "local", root / "w2")
+        print(f"local engine: 1 worker {one:.3f} samples/s, 2 workers {two:.3f} samples/s, "
+              f"efficiency {two / (2 * one):.2f}")  # fmt: skip
+        if not args.skip_ray:
+            ray = rate(args, 2, "ray", root / "ray")
+            print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
+                  f"{ray / two:.2f}x the local engine")  # fmt: skip
+        if args.rss:
+            curve = rss_curve(args, root / "rss")
+            base = next((mb for n, mb in curve if n >= 50), curve[0][1])
+            print(f"RSS after {curve[-1][0]} samples: {curve[-1][1]:.0f} MB, "
+                  f"{100 * (curve[-1][1] / base - 1):+.1f}% of the value after 50")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
