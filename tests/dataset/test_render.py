@@ -243,3 +243,18 @@ def test_loader_returns_numpy_arrays(dataset):
     np.testing.assert_allclose(lengths, 1.0, atol=1e-3)
     with pytest.raises(IndexError):
         data[3]
+
+
+def test_webdataset_shards_hold_every_sample_file(dataset, tmp_path):
+    import tarfile
+
+    from avatar.dataset import store
+
+    _, out = dataset
+    shards = store.write_shards(out, tmp_path / "shards", per_shard=2)
+    assert [p.name for p in shards] == ["shard-000000.tar", "shard-000001.tar"]
+    names = [m for p in shards for m in tarfile.open(p).getnames()]
+    assert names[:6] == [f"00000000.{n}" for n in store.SAMPLE_FILES]
+    assert len(names) == 3 * len(store.SAMPLE_FILES)
+    again = store.write_shards(out, tmp_path / "again", per_shard=2)
+    assert shards[0].read_bytes() == again[0].read_bytes()

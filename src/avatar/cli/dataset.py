@@ -34,6 +34,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = dsub.add_parser("validate", help="check a dataset folder")
     p.add_argument("output", metavar="OUT")
     p.set_defaults(run=run_validate)
+    p = dsub.add_parser("shards", help="WebDataset tar shards of a dataset folder")
+    p.add_argument("output", metavar="OUT")
+    p.add_argument("-o", "--dest", required=True, metavar="DIR", help="folder for the shards")
+    p.add_argument("--size", type=int, default=1000, help="samples per shard (default 1000)")
+    p.set_defaults(run=run_shards)
     p = dsub.add_parser("sheet", help="a contact sheet of some samples (PNG)")
     p.add_argument("output", metavar="OUT")
     p.add_argument("-o", "--png", required=True, metavar="SHEET.png")
@@ -83,6 +88,14 @@ def run_validate(args: argparse.Namespace) -> int:
         print(problem)
     print(f"{args.output}: " + ("ok" if not problems else f"{len(problems)} problems"))
     return 1 if problems else 0
+
+
+def run_shards(args: argparse.Namespace) -> int:
+    if args.size < 1:
+        raise ParameterError(f"--size must be at least 1, got {args.size}")
+    paths = store.write_shards(Path(args.output), Path(args.dest), args.size)
+    print(f"wrote {len(paths)} shards to {args.dest}")
+    return 0
 
 
 def run_sheet(args: argparse.Namespace) -> int:

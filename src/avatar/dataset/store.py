@@ -151,3 +151,27 @@ def validate(out: Path) -> list[str]:
     else:
         problems.append("coco.json missing")
     return problems
+
+
+def write_shards(out: Path, dest: Path, per_shard: int = 1000) -> list[Path]:
+    """WebDataset tar shards of the finished samples (``dest/shard-000000.tar``, ...): each
+    sample's files as ``<id>.<name>`` members (``00000042.rgb.png``, ``00000042.meta.json``),
+    in id order, so ``webdataset`` and plain ``tarfile`` stream them. Each shard is written
+    atomically; returns their paths."""
+    import tarfile
+
+    ids = sorted(done(out))
+    dest.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for n, first in enumerate(range(0, len(ids), per_shard)):
+        path = dest / f"shard-{n:06d}.tar"
+        with atomic.replacing(path) as tmp, tarfile.open(tmp, "w") as tar:
+            for i in ids[first : first + per_shard]:
+                for name in SAMPLE_FILES:
+                    member = tar.gettarinfo(sample_dir(out, i) / name, f"{i:08d}.{name}")
+                    member.mtime, member.uid, member.gid = 0, 0, 0  # same bytes every time
+                    member.uname = member.gname = ""
+                    with open(sample_dir(out, i) / name, "rb") as f:
+                        tar.addfile(member, f)
+        paths.append(path)
+    return paths
