@@ -127,7 +127,7 @@ def test_load_reads_back_what_save_wrote(tmp_path, model, suffix):
         assert sorted(skeleton.names) == sorted(human.skeleton.names) and animation.frames == 1
     else:
         assert loaded.skeleton.names == human.skeleton.names
-        assert [p.name for p in loaded.parts] == ["body", "eyes"]
+        assert [p.name for p in loaded.parts] == ["body", "eyes", "teeth", "tongue"]
 
 
 def test_load_refuses_unknown_suffixes_and_missing_files(tmp_path):
@@ -149,7 +149,7 @@ def test_the_extension_path_needs_no_pygltflib_nor_tqdm(model):
     )
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
                          text=True).stdout  # fmt: skip
-    assert out.strip() == "3"
+    assert out.strip() == "5"  # body, eyes, teeth, tongue, tshirt
 
 
 def test_create_takes_asset_folders_and_game_engine_options(fixtures, tmp_path, model):

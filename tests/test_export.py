@@ -31,7 +31,7 @@ def test_glb_round_trip(tmp_path, walker):
     path = avatar.save(human, tmp_path / "h.glb", animation, expressions=True)
     back = gltf.read(path)
     names = [p.name for p in back.parts]
-    assert names[:2] == ["body", "eyes"]
+    assert names[:4] == ["body", "eyes", "teeth", "tongue"]
     body = back.parts[0]
     np.testing.assert_allclose(body.mesh.vertices, human.mesh.vertices, atol=1e-5)
     assert len(body.morphs) == 52 and "jawOpen" in body.morphs
@@ -66,7 +66,8 @@ def test_obj_writes_every_part_with_its_mtl_and_textures(tmp_path, model):
     path = avatar.save(human, tmp_path / "h.obj")
     mesh = obj.read(path)
     parts = sizing.sized(human.parts())
-    assert list(mesh.face_groups) == [p.name for p in parts] == ["body", "eyes", "tshirt"]
+    assert list(mesh.face_groups) == [p.name for p in parts] == ["body", "eyes", "teeth",
+                                                                 "tongue", "tshirt"]
     start = 0
     for part in parts:  # vertices in part order, each part's faces under its object
         count = len(part.mesh.vertices)
@@ -75,9 +76,12 @@ def test_obj_writes_every_part_with_its_mtl_and_textures(tmp_path, model):
         assert len(mesh.face_groups[part.name]) == len(part.mesh.faces)
         start += count
     library = obj.read_mtl(path.with_suffix(".mtl"))
-    assert len(library) == 3
+    assert len(library) == 5
     for part in parts:
         entry = library[part.material.name]
+        if part.material.base_color_texture is None:  # teeth, tongue: a colour
+            assert "map_Kd" not in entry and part.name in ("teeth", "tongue")
+            continue
         texture = images.read(tmp_path / entry["map_Kd"])
         np.testing.assert_array_equal(texture, part.material.base_color_texture)
     assert "map_Pr" in library["skin"] and "map_Bump" in library["tshirt"]
@@ -113,8 +117,8 @@ def test_game_engine_options_write_a_valid_glb(tmp_path, model):
                for p in m.primitives)  # fmt: skip
     back = gltf.read(path)
     names = [p.name for p in back.parts]
-    assert names == ["body", "eyes", "tshirt", "body_LOD1", "body_LOD2", "tshirt_LOD1",
-                     "tshirt_LOD2"]  # fmt: skip
+    assert names == ["body", "eyes", "teeth", "tongue", "tshirt", "body_LOD1", "body_LOD2",
+                     "tshirt_LOD1", "tshirt_LOD2"]  # fmt: skip
     by_name = {p.name: p for p in back.parts}
     for name in ("body", "tshirt"):
         counts = [len(by_name[n].mesh.faces) for n in (name, f"{name}_LOD1", f"{name}_LOD2")]

@@ -104,7 +104,7 @@ def levels_of_detail(
     out: list[MeshPart] = []
     keyed: dict[str, np.ndarray] = {}
     for part in parts:
-        if part.name == "eyes":  # a few hundred triangles: nothing to gain
+        if part.name in ("eyes", "teeth", "tongue"):  # a few hundred triangles: no gain
             continue
         for level in range(1, lods + 1):
             mesh, source = decimate(part.mesh, 0.5**level)

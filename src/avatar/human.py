@@ -247,7 +247,7 @@ class Human:
         return Body(self.vertices, self.skeleton, self.weights, self.model, self.recipe.rig)
 
     def part(self, name: str) -> Mesh:
-        """A renderable part ("body", "eyes") as its own Mesh (helpers excluded)."""
+        """A renderable part ("body", "eyes", "teeth", "tongue") as its own Mesh."""
         base = self.model.base
         faces = np.sort(np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]]))
         mesh = base.with_vertices(self.vertices).subset(faces)
@@ -317,9 +317,11 @@ class Human:
 
     # ------------------------------------------------------------------ export
     def parts(self, expressions: bool = False, hide_covered: bool | None = None) -> list[MeshPart]:
-        """MeshParts ready for exporters and the Blender bridge: body, eyes (+ garments).
+        """MeshParts ready for exporters and the Blender bridge: body, eyes, teeth, tongue
+        (``BODY_PART_GROUPS``), then the garments.
 
-        expressions: attach the 52 ARKit face units to the body as morph targets.
+        expressions: attach the 52 ARKit face units to the body, teeth and tongue as morph
+            targets.
         hide_covered: drop body faces that garments cover entirely (their ``delete_verts``,
             MakeHuman's ``clothesHideFaces``): True for every garment, False for none (the
             whole body, e.g. for cloth simulation); None: the recipe's ``hide_covered``,
@@ -336,7 +338,8 @@ class Human:
                 mesh, index = self.part(name), self.part_vertices(name)
                 if name == "body" and hiding:
                     mesh, index = self._uncovered_body(hiding)
-                morphs = self.expression_morphs(index) if expressions and name == "body" else {}
+                # Teeth and tongue follow the jaw in the face units too (a mouth, not a hole).
+                morphs = self.expression_morphs(index) if expressions and name != "eyes" else {}
                 skin = self.weights.subset(index)
                 out.append(MeshPart(name, mesh, materials[name].result(),
                                     (skin.indices, skin.weights), morphs))  # fmt: skip
@@ -397,6 +400,9 @@ class Human:
         Avatar's procedural skin for this body's ethnicity and age."""
         if part == "eyes":
             return skin.eye_material(self.eye_colour)
+        if part in ("teeth", "tongue"):
+            age = (self.model.defaults() | self.recipe.params)["age"]
+            return skin.mouth_material(part, age=age)
         found = self._skin_file()
         if found is not None:
             loaded = material_from_file(found)

@@ -88,7 +88,8 @@ def test_dressed_human_exports_garments(model, tmp_path):
 
     human = Human({}, model=model).dressed("tshirt", "jeans", "hair-short")
     names = [p.name for p in human.parts()]
-    assert names[:2] == ["body", "eyes"] and {"tshirt", "jeans", "hair-short"} <= set(names)
+    assert names[:4] == ["body", "eyes", "teeth", "tongue"]
+    assert {"tshirt", "jeans", "hair-short"} <= set(names)
     from avatar.export import save
 
     back = gltf.read(save(human, tmp_path / "d.glb"))

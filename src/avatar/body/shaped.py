@@ -23,8 +23,15 @@ from avatar.rig.placement import RigDefinition
 from avatar.rig.skeleton import Skeleton
 from avatar.rig.skinning import SkinWeights
 
-# Renderable parts of the base mesh by their face groups (helpers excluded).
-PART_GROUPS = {"body": ("body",), "eyes": ("helper-l-eye", "helper-r-eye")}
+# Renderable parts of the base mesh by their face groups (other helpers excluded). Teeth
+# and tongue sit inside the mouth: the lower teeth are weighted to the jaw and the tongue
+# to its bones, and the face units (``expression/jawOpen``) move them with the jaw.
+PART_GROUPS = {
+    "body": ("body",),
+    "eyes": ("helper-l-eye", "helper-r-eye"),
+    "teeth": ("helper-upper-teeth", "helper-lower-teeth"),
+    "tongue": ("helper-tongue",),
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,7 +112,7 @@ def default_body(model: BodyModel, rig: str = "default") -> Body:
 
 
 def part_vertices(model: BodyModel, name: str) -> np.ndarray:
-    """Indices into the base mesh's vertices of a renderable part ("body", "eyes")."""
+    """Indices into the base mesh's vertices of a renderable part (``PART_GROUPS``)."""
     base = model.base
     faces = np.concatenate([base.face_groups[g] for g in PART_GROUPS[name]])
     return np.unique(base.faces[faces])

@@ -315,6 +315,32 @@ def _paint_mouth_parts(colour, rough) -> None:
         rough[inside] = r
 
 
+# ---------------------------------------------------------------------------- mouth
+
+MOUTH_PARTS = ("teeth", "tongue")
+
+
+def mouth_material(part: str, age: float = 0.5) -> Material:
+    """The material of a mouth part of the base mesh ("teeth" or "tongue"), plain colour.
+
+    Teeth: glossy enamel, ivory that yellows a little with ``age`` (0..1, MakeHuman's age
+    macro), translucent at the edges (a little subsurface). Tongue: wet, pink-red, with
+    subsurface scattering like the lips. Both are seen in shadow inside the mouth, so a
+    factor without texture reads right and costs nothing to export.
+    """
+    if part not in MOUTH_PARTS:
+        raise ValueError(f"mouth part must be one of {MOUTH_PARTS}, got {part!r}")
+    old = float(np.clip((age - 0.5) / 0.5, 0, 1))
+    if part == "teeth":
+        srgb = np.array(TEETH_SRGB, np.float32) * (1.0, 1.0 - 0.03 * old, 1.0 - 0.12 * old)
+        r, g, b = (float(c) for c in srgb_to_linear(srgb / 255.0))
+        return Material(name="teeth", base_color=(r, g, b, 1.0), roughness=0.18,
+                        extras={"subsurface": 0.1, "subsurface_radius": [0.004, 0.003, 0.002]})
+    r, g, b = (float(c) for c in srgb_to_linear(np.array(TONGUE_SRGB, np.float32) / 255.0))
+    return Material(name="tongue", base_color=(r, g, b, 1.0), roughness=0.3,
+                    extras={"subsurface": 0.2, "subsurface_radius": [0.01, 0.004, 0.0025]})
+
+
 # ---------------------------------------------------------------------------- eyes
 
 
