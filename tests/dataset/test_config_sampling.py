@@ -130,3 +130,27 @@ def test_bvh_clips_and_folders_are_sampled(tmp_path):
     empty.mkdir()
     with pytest.raises(AvatarError, match="no .bvh files"):
         sampling.check(config.loads(text.replace(str(clip.parent), str(empty))))
+
+
+def test_population_mode_draws_realistic_statures(model):
+    """Population mode: men about 13 cm taller than women on average, adults within the
+    surveys' spread, and the height macro hits the drawn stature exactly."""
+    from avatar.dataset import population
+
+    rng = np.random.default_rng(0)
+    men, women = [], []
+    for _ in range(120):
+        params = population.draw(rng, model, {})
+        years_adult = params["age"] >= population.age_macro(18)
+        if years_adult:
+            stature = population.stature_of(model, params) * 100
+            (men if params["gender"] > 0.5 else women).append(stature)
+    assert len(men) > 30 and len(women) > 30
+    assert 170 < np.mean(men) < 180 and 157 < np.mean(women) < 167
+    assert 8 < np.mean(men) - np.mean(women) < 18
+    assert 4 < np.std(men) < 11
+    base = {"gender": 0.9, "age": 0.6, "weight": 0.4}
+    h = population.height_macro(model, base, 1.83)
+    assert population.stature_of(model, base | {"height": h}) == pytest.approx(1.83, abs=1e-3)
+    c = config.loads(config.EXAMPLE.replace('mode = "uniform"', 'mode = "population"'))
+    assert _key(sampling.sample(c, 4)) == _key(sampling.sample(c, 4))

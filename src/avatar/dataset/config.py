@@ -38,6 +38,9 @@ samples = 16                     # Cycles samples per pixel of the RGB image
 recycle_every = 50               # a worker restarts its Blender after this many samples
 
 [bodies]
+mode = "uniform"                 # "uniform": macros drawn from the ranges below;
+                                 # "population": sex, age 11-80, stature and BMI drawn from
+                                 # adult/child statistics (see avatar.dataset.population)
 gender = [0.0, 1.0]              # MakeHuman macros, 0..1 (gender 0 = female)
 age = [0.1875, 1.0]              # 0.1875 = 11 years, 0.5 = 25, 1 = 90
 muscle = [0.0, 1.0]
@@ -99,6 +102,7 @@ class Render:
 @dataclass(frozen=True)
 class Bodies:
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    mode: str = "uniform"
     ethnicity: str = "mixed"
     attributes_sigma: float = 0.7
     rig: str = "default"
@@ -203,7 +207,7 @@ def loads(text: str, source: str = "<config>", **overrides: Any) -> Config:
                             for k, t in data.items()}}  # fmt: skip
     v.data = data
     render = v.section("render", {"resolution", "engine", "samples", "recycle_every"})
-    bodies = v.section("bodies", {*MACRO_KEYS, "ethnicity", "attributes_sigma", "rig"})
+    bodies = v.section("bodies", {*MACRO_KEYS, "mode", "ethnicity", "attributes_sigma", "rig"})
     clothes = v.section("clothes", {"tops", "bottoms", "dress_probability", "dresses", "shoes",
                                     "hair", "headwear", "face"})  # fmt: skip
     motion = v.section("motion", {"clips", "pose_probability", "poses"})
@@ -229,6 +233,7 @@ def loads(text: str, source: str = "<config>", **overrides: Any) -> Config:
         bodies=Bodies(
             ranges={k: v.pair(f"bodies.{k}", bodies, None, float, 0.0, 1.0)
                     for k in MACRO_KEYS if k in bodies},  # fmt: skip
+            mode=v.choice("bodies.mode", bodies, "uniform", ("uniform", "population")),
             ethnicity=v.choice("bodies.ethnicity", bodies, "mixed", ("mixed", "even")),
             attributes_sigma=v.number("bodies.attributes_sigma", bodies, 0.7, 0.0, 3.0),
             rig=v.choice("bodies.rig", bodies, "default", RIG_NAMES),

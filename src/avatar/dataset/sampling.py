@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar.body.model import BodyModel
 from avatar.camera import CameraModel, look_at
 from avatar.clothes import library
+from avatar.dataset import population
 from avatar.dataset.config import Config
 from avatar.errors import AvatarError, FormatError
 
@@ -85,6 +87,8 @@ def _person(config: Config, rng: np.random.Generator, k: int, count: int) -> Per
                  "belly"):  # fmt: skip
         value = float(np.clip(rng.normal(0.0, bodies.attributes_sigma), -3.0, 3.0))
         params[f"pca/{name}"] = value if bodies.attributes_sigma > 0 else 0.0
+    if bodies.mode == "population":  # sex, age, stature and build from statistics
+        params = population.draw(rng, BodyModel.shared(), params)
     clothes = _outfit(config, rng)
     motion, frame = _motion(config, rng)
     x = (k - (count - 1) / 2) * config.people.spacing
