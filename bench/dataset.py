@@ -97,23 +97,30 @@ def main() -> int:
         root = Path(tmp)
         print(f"{args.count} samples, {args.resolution}x{args.resolution}, {args.samples} spp, "
               f"{os.cpu_count()} CPUs, Python {sys.version.split()[0]}")  # fmt: skip
-        bare, labelled = bare_vs_labelled(args, root / "inproc")
-        print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
-              f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}%")
-        one = rate(args, 1, "local", root / "w1")
-        two = rate(args, 2, "local", root / "w2")
-        print(f"local engine: 1 worker {one:.3f} samples/s, 2 workers {two:.3f} samples/s, "
-              f"efficiency {two / (2 * one):.2f}")  # fmt: skip
-        if not args.skip_ray:
-            ray = rate(args, 2, "ray", root / "ray")
-            print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
-                  f"{ray / two:.2f}x the local engine")  # fmt: skip
+        if args.count == 0:  # --count 0: the memory curve only
+            args.skip_ray = True
+        else:
+            _throughput(args, root)
         if args.rss:
             curve = rss_curve(args, root / "rss")
             base = next((mb for n, mb in curve if n >= 50), curve[0][1])
             print(f"RSS after {curve[-1][0]} samples: {curve[-1][1]:.0f} MB, "
                   f"{100 * (curve[-1][1] / base - 1):+.1f}% of the value after 50")
     return 0
+
+
+def _throughput(args, root: Path) -> None:
+    bare, labelled = bare_vs_labelled(args, root / "inproc")
+    print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
+          f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}%")
+    one = rate(args, 1, "local", root / "w1")
+    two = rate(args, 2, "local", root / "w2")
+    print(f"local engine: 1 worker {one:.3f} samples/s, 2 workers {two:.3f} samples/s, "
+          f"efficiency {two / (2 * one):.2f}")  # fmt: skip
+    if not args.skip_ray:
+        ray = rate(args, 2, "ray", root / "ray")
+        print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
+              f"{ray / two:.2f}x the local engine")  # fmt: skip
 
 
 if __name__ == "__main__":
