@@ -64,7 +64,8 @@ def test_skin_texture_looks_like_skin(data_dir):
     assert 0.5 < skin_pixels.std(axis=0).mean() < 8  # subtle noise, not flat, not noisy
     lips = image[masks["lips"] > 0.9].astype(float).mean(axis=0)
     cheek = skin_pixels.mean(axis=0)
-    assert lips[0] / lips[1] > 1.25 * cheek[0] / cheek[1]  # lips are redder
+    redder = (lips[0] / lips[1]) / (cheek[0] / cheek[1])
+    assert 1.12 < redder < 1.35  # lips are redder, but not painted (over-saturated)
     nails = image[masks["fingernails"] > 0.9].astype(float).mean(axis=0)
     assert _luma(nails) > _luma(cheek)
     rough = m.roughness_texture
@@ -122,3 +123,89 @@ def test_eye_uvs_put_the_front_of_the_eyeball_on_the_iris(data_dir):
         assert image[rows[side_vertex], cols[side_vertex]].min() > 150  # sclera
     with pytest.raises(ValueError):
         skin.eye_uvs(np.array([[0.1, 0.1]]), "l")
+
+
+# ---------------------------------------------------------------------------- relief, age
+
+
+def _face_pixels(size: int) -> dict[str, np.ndarray]:
+    """Masks of the skin map: forehead, crow's-feet corner, bald scalp, cheek (by the
+    default body's position of each pixel, relative to the eyes' midpoint)."""
+    from avatar.looks import wrinkles
+
+    p = wrinkles.uv_positions(size)
+    x, y, z = np.abs(p[..., 0]), p[..., 1], p[..., 2]
+    with np.errstate(invalid="ignore"):
+        return {
+            "forehead": (z > 0.03) & (z < 0.055) & (x < 0.03) & (y < 0.02),
+            "crow": (np.hypot(x - 0.041, z) < 0.018) & (x > 0.045),
+            "scalp": (z > 0.1) & np.isfinite(z),
+        }
+
+
+def _slope(normal: np.ndarray, mask: np.ndarray) -> float:
+    """Mean tilt of a normal map's normals away from flat, over ``mask``."""
+    n = normal[mask].astype(float) / 127.5 - 1.0
+    return float(np.mean(np.hypot(n[:, 0], n[:, 1])))
+
+
+def test_skin_has_a_normal_map_and_wrinkles_come_with_age(data_dir):
+    masks = _face_pixels(512)
+    ages = (0.1, 0.5, 0.75, 1.0)
+    mats = {a: skin.skin_material(age=a, size=512, data_dir=data_dir) for a in ages}
+    for m in mats.values():
+        assert m.normal_texture.shape == (512, 512, 3) and m.normal_texture.dtype == np.uint8
+    for region in ("forehead", "crow"):
+        slopes = [_slope(mats[a].normal_texture, masks[region]) for a in ages]
+        assert slopes[1] < 1.5 * slopes[0]  # 25 years: pores, no wrinkles yet
+        assert slopes[1] < slopes[2] < slopes[3]  # deeper with age
+        assert slopes[3] > 3 * slopes[1], region  # an old face reads as old
+    rough = [mats[a].roughness_texture[masks["forehead"]].mean() for a in (0.5, 1.0)]
+    assert rough[1] > rough[0] + 10  # old skin is drier
+
+
+def test_wrinkles_lie_across_the_forehead():
+    """Forehead lines run side to side: depth varies far more going up the face than
+    along a line."""
+    from avatar.looks import wrinkles
+
+    z = np.linspace(0.03, 0.055, 400)
+    up = wrinkles._depth(np.stack([np.full_like(z, 0.01), np.zeros_like(z), z], -1))
+    x = np.linspace(0.0, 0.025, 400)
+    along = wrinkles._depth(np.stack([x, np.zeros_like(x), np.full_like(x, 0.0425)], -1))
+    assert up.max() > 0.2 and up.min() < 0.03  # grooves and flat skin between them
+    assert np.abs(np.diff(along)).sum() < 0.5 * np.abs(np.diff(up)).sum()
+    assert wrinkles.age_amount(0.5) == 0.0 and wrinkles.age_amount(1.0) == pytest.approx(1.0)
+
+
+def test_uv_positions_put_each_vertex_where_it_is(model):
+    """A pixel at a head vertex's UV holds that vertex's place (relative to the eyes)."""
+    from avatar.body.shaped import default_vertices
+    from avatar.looks import wrinkles
+
+    size = 1024
+    p = wrinkles.uv_positions(size)
+    base = model.base
+    v = default_vertices(model)
+    eyes = (v[np.unique(base.faces[base.face_groups["helper-l-eye"]])].mean(0)
+            + v[np.unique(base.faces[base.face_groups["helper-r-eye"]])].mean(0)) / 2
+    rows = base.face_groups["body"]
+    corners, uv_index = base.faces[rows].ravel(), base.face_uvs[rows].ravel()
+    head = v[corners, 2] > eyes[2] - 0.1
+    uv = base.uvs[uv_index[head]]
+    r = np.clip(((1 - uv[:, 1]) * size).astype(int), 0, size - 1)
+    c = np.clip((uv[:, 0] * size).astype(int), 0, size - 1)
+    got, want = p[r, c], v[corners[head]] - eyes
+    ok = np.isfinite(got[:, 0])
+    assert ok.mean() > 0.9
+    assert np.median(np.linalg.norm(got[ok] - want[ok], axis=1)) < 0.003
+
+
+def test_bald_scalp_has_no_dirt(data_dir):
+    """Blotches on the scalp change redness, hardly lightness: no dark patches."""
+    mask = _face_pixels(512)["scalp"]
+    image = skin.skin_material(0, 0, 1, age=1.0, gender=1.0, size=512, data_dir=data_dir)
+    lin = skin.srgb_to_linear(image.base_color_texture[mask].astype(np.float32) / 255)
+    luma = lin @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    assert luma.std() / luma.mean() < 0.06
+    assert np.percentile(luma, 1) > 0.8 * np.median(luma)  # no dark patches

@@ -26,6 +26,7 @@ import numpy as np
 
 from avatar.body import assets
 from avatar.io import images
+from avatar.looks import wrinkles
 from avatar.material import Material
 
 log = logging.getLogger(__name__)
@@ -41,7 +42,7 @@ REGIONS = {
     "face": ("mpfb_face.jpg", (1.0, 0.95, 0.93), 0.5),
     "ears": ("mpfb_ears.jpg", (1.0, 0.86, 0.83), 0.5),
     "eyelids": ("mpfb_eyelids.jpg", (0.86, 0.76, 0.76), 0.45),
-    "lips": ("mpfb_lips.jpg", (0.80, 0.48, 0.48), 0.35),
+    "lips": ("mpfb_lips.jpg", (0.88, 0.62, 0.62), 0.38),
     "aureolae": ("mpfb_aureolae.jpg", (0.62, 0.45, 0.42), 0.45),
     "crotch": ("mpfb_crotch.jpg", (0.86, 0.78, 0.76), 0.55),
     "genitals": ("mpfb_genitals.jpg", (0.74, 0.58, 0.56), 0.45),
@@ -252,36 +253,61 @@ def _skin_material(key: tuple, size: int, seed: int, data_dir: str | None) -> Ma
     colour, rough = _base_skin(tone, size, rng, age)
     _paint_regions(colour, rough, tone, masks)
     _paint_mouth_parts(colour, rough)
+    height = _relief(colour, rough, size, rng, age)
     image = np.ascontiguousarray(_to_uint8(colour))
     rough8 = np.rint(np.clip(rough, 0, 1) * 255).astype(np.uint8)
-    for array in (image, rough8):
+    normal = wrinkles.normal_map(height, wrinkles.FACE_MM_PER_PIXEL_1024 * 1024 / size)
+    for array in (image, rough8, normal):
         array.flags.writeable = False  # shared by every caller of the cache
     return Material(
         name="skin",
         base_color=(1.0, 1.0, 1.0, 1.0),
         base_color_texture=image,
+        normal_texture=normal,
         roughness=1.0,
         roughness_texture=rough8,
-        extras={"subsurface": 0.15, "subsurface_radius": [0.01, 0.004, 0.0025]},
+        extras={"subsurface": 0.2, "subsurface_radius": [0.012, 0.005, 0.003]},
     )
 
 
 def _base_skin(tone: np.ndarray, size: int, rng: np.random.Generator, age: float):
-    """(size, size, 3) linear colour and (size, size) roughness of plain skin with noise."""
+    """(size, size, 3) linear colour and (size, size) roughness of plain skin with noise.
+
+    Skin varies mostly in redness (blood under it), little in lightness: broad blotches
+    that darken read as dirt (on a bald scalp most), so the mottling shifts hue with only
+    a faint change of lightness, and the grain is fine.
+    """
     old = float(np.clip((age - 0.5) / 0.5, 0, 1))
     mottle = fractal_noise(rng, size, (6, 14, 40))  # blotches, a few cm across
-    blush = fractal_noise(rng, size, (10, 24))  # red/yellow hue drift
+    blush = fractal_noise(rng, size, (10, 24, 60))  # redness drift
     pores = fractal_noise(rng, size, (size // 8, size // 3))  # fine grain, a pixel or two
-    spots = np.clip(value_noise(rng, size, 90) - 0.55, 0, None) * old  # age spots
-    light = 1 + (0.045 + 0.03 * old) * mottle + 0.03 * pores - 0.5 * spots
-    hue = np.stack([1 + 0.025 * blush, 1 - 0.01 * blush, 1 - 0.03 * blush], axis=-1)
+    spots = np.clip(value_noise(rng, size, 90) - 0.6, 0, None) * old  # age spots
+    light = 1 + (0.012 + 0.015 * old) * mottle + 0.035 * pores - 0.35 * spots
+    red = 0.03 * blush + 0.012 * mottle
+    hue = np.stack([1 + red, 1 - 0.6 * red, 1 - 0.8 * red], axis=-1)
+    spot_hue = np.array([1.0, 0.96, 0.88], np.float32)  # age spots are brown, not grey
     colour = tone[None, None, :] * light[..., None] * hue
-    rough = 0.55 + 0.08 * old + 0.05 * pores + 0.03 * mottle
+    colour *= 1 + (spot_hue - 1) * np.clip(spots * 4, 0, 1)[..., None]
+    rough = 0.5 + 0.1 * old + 0.06 * pores + 0.02 * mottle
     return colour.astype(np.float32), rough.astype(np.float32)
 
 
+def _relief(colour, rough, size: int, rng: np.random.Generator, age: float) -> np.ndarray:
+    """(size, size) skin height in millimetres: fine pores everywhere and, with age,
+    wrinkles (``looks.wrinkles``); their valleys get a little darker and drier in place."""
+    pores = fractal_noise(rng, size, (size // 6, size // 2))
+    amount = wrinkles.age_amount(age)
+    height = 0.025 * (1 + 0.5 * amount) * pores
+    if amount > 0:
+        depth = wrinkles.wrinkle_depth(wrinkles.uv_positions(size)) * np.float32(amount)
+        height -= depth
+        colour *= (1 - 0.35 * np.clip(depth, 0, 0.5))[..., None]  # a shadow deep in a crease
+        rough += 0.25 * np.clip(depth, 0, 0.5)
+    return height.astype(np.float32)
+
+
 def _paint_regions(colour, rough, tone, masks: dict[str, np.ndarray]) -> None:
-    """Blend each masked region's tint and roughness in place (within its bounding box)."""
+    """Blend each masked region's tint and roughness offset in place (in its bounding box)."""
     nail, mouth = _linear(NAIL_SRGB), _linear(MOUTH_SRGB)
     for name, (_, tint, region_rough) in REGIONS.items():
         if name not in masks or not masks[name].any():
@@ -296,7 +322,8 @@ def _paint_regions(colour, rough, tone, masks: dict[str, np.ndarray]) -> None:
         else:  # nails: pale, taking a little of the skin's colour through them
             target = 0.75 * nail + 0.25 * tone
         colour[box] = c + (target - c) * m
-        rough[box] += (np.float32(region_rough) - rough[box]) * m[..., 0]
+        # Relative to plain skin (0.55), so age's drier skin shows in every region.
+        rough[box] += (np.float32(region_rough) - np.float32(0.55)) * m[..., 0]
 
 
 def _bounding_box(mask: np.ndarray) -> tuple[slice, slice]:
