@@ -56,6 +56,53 @@ class Step:
 
 
 @dataclass
+class Batch:
+    """Single bones solved together (their anchors solved before them): the ``Step`` fields
+    of n bones stacked, keypoints padded to the most any of them carries (m).
+
+    steps (n,); anchor (n,); rel (n, 3, 3); step (n, 3); points (n, m) keypoint indices
+    (0 where padded), real (n, m) bool (False: padding); offsets (n, m, 3); origin (n,)
+    (-1: none); pole: has_pole (n,), pole_mid, pole_far (n,) keypoints, pole_axis (n, 3);
+    limit (n,) radians, limited (n,) bool (a limit below a half turn).
+    """
+
+    steps: np.ndarray
+    anchor: np.ndarray
+    rel: np.ndarray
+    step: np.ndarray
+    points: np.ndarray
+    real: np.ndarray
+    offsets: np.ndarray
+    origin: np.ndarray
+    has_pole: np.ndarray
+    pole_mid: np.ndarray
+    pole_far: np.ndarray
+    pole_axis: np.ndarray
+    limit: np.ndarray
+    limited: np.ndarray
+
+
+def make_batch(steps: list[Step], ids: list[int]) -> Batch:
+    """Stack the steps ``ids`` (none anchored on another of them) into one ``Batch``."""
+    chosen = [steps[i] for i in ids]
+    m = max([len(st.points) for st in chosen] + [1])
+    n = len(ids)
+    points, real, offsets = np.zeros((n, m), int), np.zeros((n, m), bool), np.zeros((n, m, 3))
+    pole_mid, pole_far, pole_axis = np.zeros(n, int), np.zeros(n, int), np.zeros((n, 3))
+    for r, st in enumerate(chosen):
+        count = len(st.points)
+        points[r, :count], real[r, :count], offsets[r, :count] = st.points, True, st.offsets
+        if st.pole is not None:
+            pole_mid[r], pole_far[r], pole_axis[r] = st.pole[0], st.pole[1], st.pole[2]
+    limit = np.array([st.limit for st in chosen], dtype=np.float64)
+    return Batch(np.array(ids, int), np.array([st.anchor for st in chosen], int),
+                 np.array([st.rel for st in chosen]), np.array([st.step for st in chosen]),
+                 points, real, offsets, np.array([st.origin for st in chosen], int),
+                 np.array([st.pole is not None for st in chosen]), pole_mid, pole_far,
+                 pole_axis, limit, limit < np.pi)  # fmt: skip
+
+
+@dataclass
 class Chain:
     """Bones sharing one turn (spine, neck): indices into the plan's steps, first to last,
     and the keypoints they place (including those of the solved bones hanging on their last
@@ -66,6 +113,18 @@ class Chain:
     points: np.ndarray
     offsets: np.ndarray  # (n, 3) at rest, in the first bone's frame
     tips: list[int]  # steps hanging on the chain whose points it uses
+    # Precomputed for the per-frame solve: each point's owner (index into steps + tips),
+    # its offset in the owner's frame; the steps' rest rotations relative to the first
+    # bone's; the tips as a Batch (solved between the two spine passes).
+    owner: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    owner_offsets: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    rest_rel: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))
+    tip_batch: Batch | None = None
+    rel: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3)))  # the steps' rel
+    step: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the steps' step
+    limit: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the steps' limit
+    anchor: int = -1  # the first step's anchor
+    tip_on: np.ndarray = field(default_factory=lambda: np.zeros(0, int))  # tips' anchors in steps
 
 
 @dataclass
@@ -74,6 +133,9 @@ class Plan:
     steps: list[Step]
     chains: dict[str, Chain]
     order: list[tuple[str, object]]  # ("root", i) / ("chain", name) / ("bone", i)
+    # The same work as ``order`` with runs of single bones grouped into dependency levels:
+    # ("root", 0) / ("chain", name) / ("bones", Batch).
+    schedule: list[tuple[str, object]]
     index: dict[int, int]  # rig bone -> step
     role_steps: dict[str, int]
     hip_points: tuple[int, int]  # keypoints at the left and right hip joints
@@ -149,8 +211,33 @@ def make_plan(rig: RigKeypoints) -> Plan:
     ank = (point("foot.L"), point("foot.R"))
     leg = [float(np.linalg.norm(sk.heads[roles[f"foot.{s}"]] - sk.heads[roles[f"thigh.{s}"]]))
            for s in "LR" if f"foot.{s}" in roles]  # fmt: skip
-    return Plan(rig, steps, chains, order, index, {s.role: i for i, s in enumerate(steps)},
-                hip, sho, ank, float(np.mean(leg)) if leg else 0.9)  # fmt: skip
+    return Plan(rig, steps, chains, order, _schedule(steps, order), index,
+                {s.role: i for i, s in enumerate(steps)}, hip, sho, ank,
+                float(np.mean(leg)) if leg else 0.9)  # fmt: skip
+
+
+def _schedule(steps: list[Step], order: list[tuple[str, object]]) -> list[tuple[str, object]]:
+    """``order`` with each run of single bones split into levels (a bone one level below
+    its anchor when the anchor is in the same run), each level one Batch."""
+    out: list[tuple[str, object]] = []
+    run: list[int] = []
+
+    def flush() -> None:
+        level: dict[int, int] = {}
+        for i in run:
+            level[i] = level[steps[i].anchor] + 1 if steps[i].anchor in level else 0
+        for depth in range(max(level.values(), default=-1) + 1):
+            out.append(("bones", make_batch(steps, [i for i in run if level[i] == depth])))
+        run.clear()
+
+    for kind, item in order:
+        if kind == "bone":
+            run.append(int(item))  # type: ignore[call-overload]
+            continue
+        flush()
+        out.append((kind, item))
+    flush()
+    return out
 
 
 def _solved_above(sk, bone: int, index: dict[int, int]) -> int:
@@ -201,6 +288,16 @@ def _chain(rig: RigKeypoints, steps: list[Step], members: list[int], tip_role: s
     rest0 = sk.rest[first, :3, :3]
     tips = [i for i, st in enumerate(steps)
             if st.anchor in members and st.role == tip_role]  # fmt: skip
-    ks = [int(k) for i in members + tips for k in steps[i].points]
+    owners = members + tips
+    ks = [int(k) for i in owners for k in steps[i].points]
     offsets = (rig.rest[ks] - sk.heads[first]) @ rest0 if ks else np.zeros((0, 3))
-    return Chain(members, np.array(ks, dtype=int), offsets, tips)
+    owner = np.array([r for r, i in enumerate(owners) for _ in steps[i].points], dtype=int)
+    owner_offsets = (np.concatenate([steps[i].offsets for i in owners]) if ks
+                     else np.zeros((0, 3)))  # fmt: skip
+    rest_rel = np.array([rest0.T @ sk.rest[steps[i].bone, :3, :3] for i in members])
+    return Chain(members, np.array(ks, dtype=int), offsets, tips, owner, owner_offsets,
+                 rest_rel, make_batch(steps, tips) if tips else None,
+                 np.array([steps[i].rel for i in members]),
+                 np.array([steps[i].step for i in members]),
+                 np.array([steps[i].limit for i in members]), steps[members[0]].anchor,
+                 np.array([members.index(steps[i].anchor) for i in tips], dtype=int))

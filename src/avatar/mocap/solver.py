@@ -22,7 +22,10 @@ Per frame (``PoseSolver.__call__``), in the order of ``plan.make_plan``:
 8. feet planted while a contact is detected (ankle near the floor and slow), by two-bone
    leg IK, released smoothly (``feet``).
 
-``solve`` runs a whole clip; ``PoseSolver`` is the streaming form (one frame, < 1 ms).
+``solve`` runs a whole clip; ``PoseSolver`` is the streaming form. Single bones are solved a
+dependency level at a time (``plan.Batch``: both arms and legs in one set of array
+operations), chains in closed form per iteration, so a frame costs a fixed few hundred numpy
+calls whatever the rig (``bench/mocap.py`` times it).
 """
 
 from __future__ import annotations
@@ -37,8 +40,7 @@ from avatar.mocap import rotations as rot
 from avatar.mocap.feet import FootPlanter
 from avatar.mocap.filters import OneEuro, PointFilter
 from avatar.mocap.keypoints import RigKeypoints
-from avatar.mocap.plan import Plan, Step, make_plan
-from avatar.rig import quaternion
+from avatar.mocap.plan import Batch, Plan, make_plan
 from avatar.rig.skeleton import Animation
 
 
@@ -99,6 +101,12 @@ class PoseSolver:
             self.plan.steps[0].offsets,
             (rig.rest[sho] - sk.heads[self._hips]) @ self._rest[self._hips]])  # fmt: skip
         self._feet = FootPlanter(self.plan)
+        self._bones = np.array([st.bone for st in self.plan.steps])
+        carried = [(k, i, st.offsets[r]) for i, st in enumerate(self.plan.steps)
+                   for r, k in enumerate(st.points)]  # fmt: skip
+        self._point_ids = np.array([c[0] for c in carried], dtype=int)
+        self._point_owner = np.array([c[1] for c in carried], dtype=int)
+        self._point_offsets = np.array([c[2] for c in carried]).reshape(-1, 3)
         self.reset()
 
     def reset(self) -> None:
@@ -140,8 +148,7 @@ class PoseSolver:
         return self._solve(p, ok, w, t, dt)
 
     def _solve(self, p, ok, w, t, dt) -> SolvedFrame:
-        steps = self.plan.steps
-        n = len(steps)
+        n = len(self.plan.steps)
         world = np.empty((n, 3, 3))
         heads = np.empty((n, 3))
         local = np.empty((n, 3, 3))
@@ -149,15 +156,15 @@ class PoseSolver:
         decay = math.exp(-dt / self.settings.hold) if self.settings.hold > 0 else 0.0
         frame = _Frame(p, ok, w, world, heads, local, solved, decay)
         self._solve_root(frame)
-        for kind, item in self.plan.order[1:]:
+        for kind, item in self.plan.schedule[1:]:
             if kind == "chain":
                 self._solve_chain(frame, str(item))
+                tips = self.plan.chains[str(item)].tip_batch
+                if item == "spine_chain" and tips is not None:
+                    self._solve_bones(frame, tips)  # again, with the clavicles just solved
+                    self._solve_chain(frame, "spine_chain")
             else:
-                self._solve_bone(frame, int(item))  # type: ignore[call-overload]
-            if item == "spine_chain":  # again, with the clavicles just solved
-                for i in self.plan.chains["spine_chain"].tips:
-                    self._solve_bone(frame, i)
-                self._solve_chain(frame, "spine_chain")
+                self._solve_bones(frame, item)  # type: ignore[arg-type]
         contacts = np.zeros(2, dtype=bool)
         if self.settings.plant_feet:
             contacts = self._feet(frame, dt, self._inherit)
@@ -183,6 +190,28 @@ class PoseSolver:
             f.solved[i] = True
         f.local[i] = local
         f.world[i] = base @ local
+
+    def _finish_many(self, f: _Frame, batch: Batch, base: np.ndarray, world: np.ndarray,
+                     solved: np.ndarray) -> None:  # fmt: skip
+        """``_finish`` for a batch: rows where ``solved`` take ``world`` (n, 3, 3), the
+        others are held."""
+        ids = batch.steps
+        local = base.transpose(0, 2, 1) @ world
+        if not solved.all():
+            held = ids[~solved]
+            last = rot.power_many(self._last[held], f.decay) if f.decay else np.eye(3)
+            self._last[held] = last
+            local[~solved] = self._last[held]
+        if self.settings.limits:
+            over = solved & batch.limited
+            if over.any():
+                over &= rot.angle_many(local) > batch.limit
+                for r in np.flatnonzero(over):  # rare: the scalar clamp
+                    local[r] = rot.clamp(local[r], float(batch.limit[r]))
+        self._last[ids[solved]] = local[solved]
+        f.solved[ids] |= solved
+        f.local[ids] = local
+        f.world[ids] = base @ local
 
     # -- root ----------------------------------------------------------------------------
 
@@ -253,12 +282,10 @@ class PoseSolver:
 
     def _solve_chain(self, f: _Frame, name: str) -> None:
         chain = self.plan.chains[name]
-        steps = self.plan.steps
-        tips: dict[int, np.ndarray | None] = dict.fromkeys(chain.tips)
+        given: dict[int, np.ndarray | None] = {}
         if name == "neck_chain":  # the head's own rigid fit places and turns it
-            tips = {i: self._rigid(f, i) for i in chain.tips}
-        first = chain.steps[0]
-        base0, head0 = self._inherit(f, first)
+            given = {i: self._rigid(f, i) for i in chain.tips}
+        base0, head0 = self._inherit(f, chain.steps[0])
         keep = f.ok[chain.points] if len(chain.points) else np.zeros(0, bool)
         b = f.p[chain.points[keep]] - head0
         wt = f.w[chain.points[keep]]
@@ -273,18 +300,37 @@ class PoseSolver:
                 base, f.heads[i] = self._inherit(f, i)
                 self._finish(f, i, base, None)
             return
-        rest0 = self._rest[steps[first].bone]
-        at_rest = [base0 @ rest0.T @ self._rest[steps[i].bone] for i in chain.steps]
-        count = len(chain.steps)
-        for _ in range(3):  # the shared bend moves the points: fit the residual turn
-            for k, i in enumerate(chain.steps):
-                base, f.heads[i] = self._inherit(f, i)
-                self._finish(f, i, base, rot.power(turn, (k + 1) / count) @ at_rest[k])
-            got = self._chain_points(f, chain, tips)[keep] - head0
+        at_rest = base0 @ chain.rest_rel  # (n, 3, 3) the chain's bones at rest
+        fractions = np.arange(1, len(chain.steps) + 1) / len(chain.steps)
+        for attempt in range(3):  # the shared bend moves the points: fit the residual turn
+            axis, angle = rot.log(turn)
+            world = rot.turns_about(axis, angle * fractions) @ at_rest
+            if attempt == 2:
+                break  # a fix found now would not be applied
+            got = self._chain_points(f, chain, world, given)[keep] - head0
             fix = rot.kabsch(got, b, wt) if len(b) >= 2 else rot.between(wt @ got, wt @ b)
             if fix is None or rot.angle_of(fix) < 1e-5:
                 break
             turn = fix @ turn
+        self._place_chain(f, chain, world)
+
+    def _place_chain(self, f: _Frame, chain, world: np.ndarray) -> None:
+        """Pose a chain's bones at world rotations (n, 3, 3), each relative to the one
+        before; bone by bone (``_finish``) only where a joint limit bites."""
+        ids, anchor = chain.steps, chain.anchor
+        above = np.concatenate([f.world[anchor][None], world[:-1]])
+        base = above @ chain.rel
+        local = base.transpose(0, 2, 1) @ world
+        if self.settings.limits and (rot.angle_many(local) > chain.limit).any():
+            for k, i in enumerate(chain.steps):
+                base_k, f.heads[i] = self._inherit(f, i)
+                self._finish(f, i, base_k, world[k])
+            return
+        f.heads[ids] = f.heads[anchor] + np.cumsum((above @ chain.step[:, :, None])[:, :, 0], 0)
+        self._last[ids] = local
+        f.solved[ids] = True
+        f.local[ids] = local
+        f.world[ids] = base @ local
 
     def _rigid(self, f: _Frame, i: int) -> np.ndarray | None:
         """World rotation of bone i from a rigid fit (rotation and translation) of its own
@@ -296,69 +342,86 @@ class PoseSolver:
         a, b, wt = st.offsets[keep], f.p[st.points[keep]], f.w[st.points[keep]]
         return rot.kabsch(a - (wt @ a) / wt.sum(), b - (wt @ b) / wt.sum(), wt)
 
-    def _chain_points(self, f: _Frame, chain, tips: dict) -> np.ndarray:
-        """(n, 3) the chain's keypoints in the current pose; the bones hanging on it
-        (``tips``: bone -> world rotation or None) in their latest pose relative to it."""
-        steps = self.plan.steps
-        out = []
-        for i in chain.steps:
-            st = steps[i]
-            out.append(f.heads[i] + st.offsets @ f.world[i].T)
-        for i in chain.tips:
-            st = steps[i]
-            wa = f.world[st.anchor]
-            world, head = wa @ st.rel @ self._last[i], f.heads[st.anchor] + wa @ st.step
-            given = tips.get(i)
-            out.append(head + st.offsets @ (world if given is None else given).T)
-        return np.concatenate(out) if out else np.zeros((0, 3))
+    def _chain_points(self, f: _Frame, chain, world: np.ndarray, given: dict) -> np.ndarray:
+        """(n, 3) the chain's keypoints with its bones at world rotations (c, 3, 3); the
+        bones hanging on it (``chain.tips``) in their latest pose relative to it, or at
+        the world rotation ``given`` maps them to (None: the latest)."""
+        above = np.concatenate([f.world[chain.anchor][None], world[:-1]])
+        heads = f.heads[chain.anchor] + np.cumsum((above @ chain.step[:, :, None])[:, :, 0], 0)
+        if chain.tips:
+            tips, on = chain.tip_batch, chain.tip_on
+            wa = world[on]
+            tip_world = wa @ tips.rel @ self._last[tips.steps]
+            for r, i in enumerate(chain.tips):
+                if given.get(i) is not None:
+                    tip_world[r] = given[i]
+            tip_heads = heads[on] + (wa @ tips.step[:, :, None])[:, :, 0]
+            world = np.concatenate([world, tip_world])
+            heads = np.concatenate([heads, tip_heads])
+        own = chain.owner
+        return heads[own] + (world[own] @ chain.owner_offsets[:, :, None])[:, :, 0]
 
-    # -- single bones ----------------------------------------------------------------------
+    # -- single bones, a level at a time ---------------------------------------------------
 
-    def _solve_bone(self, f: _Frame, i: int) -> None:
-        st: Step = self.plan.steps[i]
-        base, f.heads[i] = self._inherit(f, i)
-        keep = f.ok[st.points]
-        if not keep.any():
-            self._finish(f, i, base, None)
-            return
-        origin = f.p[st.origin] if st.origin >= 0 and f.ok[st.origin] else f.heads[i]
-        b = f.p[st.points[keep]] - origin
-        a = st.offsets[keep] @ base.T
-        wt = f.w[st.points[keep]]
-        turn = rot.kabsch(a, b, wt) if len(b) >= 2 else None
-        if turn is None:
-            turn = rot.between(wt @ a, wt @ b)
-            world = turn @ base
-            if st.pole is not None:
-                world = self._twist(f, st, world, wt @ b)
-        else:
-            world = turn @ base
-        self._finish(f, i, base, world)
+    def _solve_bones(self, f: _Frame, batch: Batch) -> None:
+        """Swing (and twist) each bone of a batch onto its keypoints, all at once: a rigid
+        turn where two or more points fix one, else the shortest arc onto their weighted
+        direction, twisted into the limb's plane for upper arms and thighs."""
+        wa = f.world[batch.anchor]
+        base = wa @ batch.rel
+        f.heads[batch.steps] = head = f.heads[batch.anchor] + (wa @ batch.step[:, :, None])[:, :, 0]
+        keep = f.ok[batch.points] & batch.real
+        count = keep.sum(1)
+        has_origin = batch.origin >= 0
+        has_origin[has_origin] = f.ok[batch.origin[has_origin]]
+        origin = np.where(has_origin[:, None], f.p[batch.origin], head)
+        b = np.where(keep[:, :, None], f.p[batch.points] - origin[:, None, :], 0.0)
+        a = batch.offsets @ base.transpose(0, 2, 1)
+        wt = np.where(keep, f.w[batch.points], 0.0)
+        world = base.copy()
+        arc = count >= 1
+        many = count >= 2
+        if many.any():
+            turn, fixed = rot.kabsch_many(a[many], b[many], wt[many])
+            rows = np.flatnonzero(many)
+            world[rows[fixed]] = turn[fixed] @ base[rows[fixed]]
+            arc[rows[fixed]] = False
+        if arc.any():
+            along = (wt[arc, :, None] * b[arc]).sum(1)
+            turned = rot.between_many((wt[arc, :, None] * a[arc]).sum(1), along) @ base[arc]
+            twist = batch.has_pole[arc]
+            if twist.any():
+                rows = np.flatnonzero(arc)[twist]
+                turned[twist] = self._twist(f, batch, rows, turned[twist], along[twist])
+            world[arc] = turned
+        self._finish_many(f, batch, base, world, count >= 1)
 
-    def _twist(self, f: _Frame, st: Step, world: np.ndarray, along: np.ndarray) -> np.ndarray:
-        """Turn a limb's upper bone about its own axis so its bend axis lies along the
-        normal of the observed plane of the limb's three joints (weighted by how bent the
-        limb is: a straight limb keeps the swing's twist)."""
-        assert st.pole is not None
-        mid, far, axis = st.pole
-        if st.origin < 0 or not f.ok[[st.origin, mid, far]].all():
+    def _twist(self, f: _Frame, batch: Batch, rows: np.ndarray, world: np.ndarray,
+               along: np.ndarray) -> np.ndarray:  # fmt: skip
+        """Turn limbs' upper bones (``rows`` of the batch, world (r, 3, 3), aimed along
+        (r, 3)) about their own axes so each bend axis lies along the normal of the
+        observed plane of the limb's three joints (weighted by how bent the limb is: a
+        straight limb keeps the swing's twist)."""
+        origin, mid, far = batch.origin[rows], batch.pole_mid[rows], batch.pole_far[rows]
+        seen = (origin >= 0) & f.ok[origin] & f.ok[mid] & f.ok[far]
+        upper, lower = f.p[mid] - f.p[origin], f.p[far] - f.p[mid]
+        normal = rot.cross_many(upper, lower)
+        with np.errstate(invalid="ignore"):
+            bend = np.sqrt((normal * normal).sum(1)) / (
+                np.sqrt((upper * upper).sum(1) * (lower * lower).sum(1)) + 1e-12)
+        weight = np.clip((bend - 0.05) / 0.15, 0.0, 1.0)  # sin of the bend: 3..11 degrees
+        weight = np.where(seen, weight, 0.0)
+        length = np.sqrt((along * along).sum(1))[:, None]
+        d = np.where(length > 1e-12, along / np.where(length > 1e-12, length, 1.0), along)
+        have = (world @ batch.pole_axis[rows][:, :, None])[:, :, 0]
+        have = have - d * (have * d).sum(1)[:, None]
+        want = normal - d * (normal * d).sum(1)[:, None]
+        live = (weight > 0) & ((have * have).sum(1) >= 1e-12) & ((want * want).sum(1) >= 1e-12)
+        if not live.any():
             return world
-        upper, lower = f.p[mid] - f.p[st.origin], f.p[far] - f.p[mid]
-        normal = rot.cross(upper, lower)
-        bend = float(np.linalg.norm(normal)) / (
-            float(np.linalg.norm(upper) * np.linalg.norm(lower)) + 1e-12
-        )
-        weight = min(max((bend - 0.05) / 0.15, 0.0), 1.0)  # sin of the bend: 3..11 degrees
-        if weight == 0.0:
-            return world
-        d = rot.unit(along)
-        have = world @ axis
-        have = have - d * (have @ d)
-        want = normal - d * (normal @ d)
-        if have @ have < 1e-12 or want @ want < 1e-12:
-            return world
-        angle = math.atan2(float(np.cross(have, want) @ d), float(have @ want))
-        return rot.axis_angle(d, weight * angle) @ world
+        angle = np.arctan2((rot.cross_many(have, want) * d).sum(1), (have * want).sum(1))
+        angle = np.where(live, weight * angle, 0.0)
+        return rot.axis_angle_many(np.nan_to_num(d), np.nan_to_num(angle)) @ world
 
     # -- output ----------------------------------------------------------------------------
 
@@ -367,14 +430,12 @@ class PoseSolver:
         count = len(sk.names)
         rotations = np.zeros((count, 4))
         rotations[:, 0] = 1.0
-        bones = [st.bone for st in self.plan.steps]
-        rotations[bones] = quaternion.from_matrix(f.local)
+        rotations[self._bones] = rot.quaternions(f.local)
         translations = np.zeros((count, 3))
         translations[self._hips] = self._rest[self._hips].T @ (f.heads[0] - sk.heads[self._hips])
         points = np.full((len(self.rig.keypoints.names), 3), np.nan)
-        for i, st in enumerate(self.plan.steps):
-            if len(st.points):
-                points[st.points] = f.heads[i] + st.offsets @ f.world[i].T
+        own, off = self._point_owner, self._point_offsets
+        points[self._point_ids] = f.heads[own] + (f.world[own] @ off[:, :, None])[:, :, 0]
         return SolvedFrame(rotations, translations, points, t, f.solved.copy(), contacts)
 
 
