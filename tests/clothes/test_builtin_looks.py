@@ -138,3 +138,125 @@ def test_hair_stays_outside_varied_bodies():
             _, depth = collision.penetration(human.vertices[:13380], faces, part.mesh.vertices)
             worst = max(worst, float(depth.max()))
     assert worst <= 0.001, f"a hair vertex is {worst * 1000:.2f} mm inside the body"
+
+
+# ---------------------------------------------------------------------------- shoes
+
+
+def _rows_of(mesh) -> np.ndarray:
+    """(V,) the atlas row (shoes.ROWS name) each vertex's UVs fall in."""
+    from avatar.clothes import shoes
+
+    v = np.zeros(len(mesh.vertices))
+    v[mesh.faces.ravel()] = mesh.uvs[mesh.face_uvs.ravel(), 1]
+    names = list(shoes.ROWS)
+    return np.array([next(n for n in names if shoes.ROWS[n][0] <= x <= shoes.ROWS[n][1])
+                     for x in v])  # fmt: skip
+
+
+def test_shoes_have_sole_heel_toe_cap_and_laces(body):
+    from avatar.clothes import shoes
+
+    mesh = builtin.BY_NAME["shoes"].make(body).mesh
+    rows = _rows_of(mesh)
+    assert set(rows) == {"upper", "cap", "sole", "laces"}
+    left = mesh.vertices[:, 0] > 0
+    foot = shoes.Foot(body, 0)
+    v = mesh.vertices[left]
+    r = rows[left]
+    sole, t = v[r == "sole"], foot.along(v[r == "sole"])
+    # A flat tread under heel and ball, below the foot; lifted under the arch (heel block).
+    heel, ball, arch = sole[t < 0.2], sole[(t > 0.7) & (t < 0.85)], sole[np.abs(t - 0.45) < 0.05]
+    tread = sole[:, 2].min()
+    assert tread < foot.ground - 0.005
+    assert heel[:, 2].min() - tread < 0.001 and ball[:, 2].min() - tread < 0.001
+    assert arch[:, 2].min() > tread + 0.004
+    # The sole stands out of the upper (a welt) all round.
+    upper = v[r == "upper"]
+    low = upper[upper[:, 2] < foot.ground + 0.03]
+    assert np.ptp(sole[:, 0]) > np.ptp(low[:, 0]) + 0.004
+    # Toe cap over the front, laces over the instep, above the upper.
+    cap, laces = v[r == "cap"], v[r == "laces"]
+    assert foot.along(cap).min() > 0.7
+    assert 0.4 < foot.along(laces).mean() < 0.8
+    assert laces[:, 2].min() > np.median(upper[:, 2])
+    # The shoe is longer than the foot: a toe box.
+    assert v[:, 1].min() < foot.toe_y - 0.008
+
+
+def test_shoe_material_is_an_atlas_of_leather_rubber_and_cord():
+    m = builtin.build(builtin.BY_NAME["shoes"], library.authoring_body(), 256).material
+    assert m.base_color_texture.shape == (256, 256, 3) and m.normal_texture is not None
+    assert [row[2] for row in m.extras["rows"]] == ["calf", "calf", "rubber", "cord"]
+    image = m.base_color_texture.astype(float)
+    sole, laces = image[int(256 * 0.75)].mean(0), image[int(256 * 0.95)].mean(0)
+    assert laces.mean() > 3 * sole.mean()  # cream laces, dark rubber
+
+
+def _bumpiness(mesh, keep: np.ndarray) -> float:
+    """Mean distance of the kept vertices from the average of their mesh neighbours."""
+    a, b = mesh.faces.ravel(), np.roll(mesh.faces, -1, axis=1).ravel()
+    total = np.zeros_like(mesh.vertices, dtype=np.float64)
+    np.add.at(total, a, mesh.vertices[b])
+    np.add.at(total, b, mesh.vertices[a])
+    count = np.bincount(a, minlength=len(mesh.vertices)) + np.bincount(b, minlength=len(
+        mesh.vertices))
+    off = np.linalg.norm(mesh.vertices - total / np.maximum(count, 1)[:, None], axis=1)
+    return float(off[keep].mean())
+
+
+def test_shoe_upper_is_smooth_not_toes(body, monkeypatch):
+    """The toe box is smoothed: the bumps of the toes do not show through the leather."""
+    from avatar.clothes import shoes
+
+    foot = shoes.Foot(body, 0)
+    smooth = shoes.upper(body, foot).mesh
+    monkeypatch.setattr(shoes, "_toe_box", lambda body, foot, mesh, ease: mesh)
+    raw = shoes.upper(body, foot).mesh
+    front = []
+    for m in (smooth, raw):  # the forefoot, not the edges the sole and opening keep
+        rim = np.zeros(len(m.vertices), bool)
+        rim[boundary_edges(m.faces)[0].ravel()] = True
+        front.append((foot.along(m.vertices) > 0.75) & ~rim)
+    assert _bumpiness(smooth, front[0]) < 0.75 * _bumpiness(raw, front[1])
+
+
+# ---------------------------------------------------------------------------- hair styles
+
+
+def test_there_are_at_least_six_hair_styles():
+    names = {s.name for s in builtin.SPECS if s.category == "hair"}
+    assert {"hair-short", "hair-long", "hair-ponytail", "hair-buzz", "hair-bob",
+            "hair-bun"} <= names  # fmt: skip
+
+
+def test_buzz_cut_is_close_to_the_scalp(body):
+    centre, _ = hair.head_frame(body)
+    mesh = builtin.BY_NAME["hair-buzz"].make(body).mesh
+    short = builtin.BY_NAME["hair-short"].make(body).mesh
+    cap = hair.base_cap(body).mesh.vertices
+    skull = np.percentile(np.linalg.norm(cap - centre, axis=1), 90)
+    buzz = np.percentile(np.linalg.norm(mesh.vertices - centre, axis=1), 90)
+    longer = np.percentile(np.linalg.norm(short.vertices - centre, axis=1), 90)
+    assert buzz - skull < 0.004 < longer - skull  # millimetres off the scalp, not a mop
+
+
+def test_bob_falls_to_the_jaw_with_a_fringe_above_the_eyes(body):
+    mesh = builtin.BY_NAME["hair-bob"].make(body).mesh
+    centre, eye_z = hair.head_frame(body)
+    v = mesh.vertices
+    assert eye_z - 0.125 < v[:, 2].min() < eye_z - 0.06  # a blunt line at the jaw
+    sides = np.abs(v[:, 0]) > 0.07
+    assert (v[sides, 2] < eye_z - 0.05).sum() > 500  # hangs down both sides
+    face = (hair.around(v, centre) < 30) & (v[:, 1] < centre[1] - 0.05)
+    assert v[face, 2].min() > eye_z + 0.02  # the fringe stops above the eyes
+
+
+def test_bun_sits_high_on_the_back_of_the_head(body):
+    mesh = builtin.BY_NAME["hair-bun"].make(body).mesh
+    centre, eye_z = hair.head_frame(body)
+    back = body.vertices[:13380][body.part[:13380] == "head"][:, 1].max()
+    behind = mesh.vertices[mesh.vertices[:, 1] > back + 0.02]
+    assert len(behind) > 200
+    assert behind[:, 2].mean() > eye_z + 0.04
+    assert np.ptp(behind[:, 0]) < 0.1  # a knot, not a curtain

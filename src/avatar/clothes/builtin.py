@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar.clothes import face, hair
+from avatar.clothes import face, hair, shoes
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -25,6 +25,7 @@ from avatar.clothes.authoring import (
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
 from avatar.looks import fabrics, textures
+from avatar.material import Material
 
 RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
 
@@ -42,6 +43,8 @@ class Spec:
     z_depth: int
     tags: tuple[str, ...] = ()
     collide: bool = True
+    # (spec, texture size) -> Material, for garments of several materials in one atlas.
+    look: Callable[[Spec, int], Material] | None = None
 
 
 def _tights(body: AuthoringBody, keep_fn, ease) -> Piece:
@@ -109,10 +112,6 @@ def socks(ff, m):
     return (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > 0.78))
 
 
-def shoes(ff, m):
-    return (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > 0.96))
-
-
 def bodice(ff, m):
     return (ff.part == "torso") & (_z(ff) > m.hip[0, 2] + 0.02) & (_z(ff) < m.chest_z + 0.12)
 
@@ -124,6 +123,22 @@ def flare(base: float, extra: float, start: float = 0.0):
 
 def sleeve_ease(base: float, extra: float):
     return lambda p, arm, leg: base + extra * np.clip(arm, 0, 1)
+
+
+def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
+              cap_colour: str | None = None):  # fmt: skip
+    """A shoe's atlas material (``shoes.ROWS``): upper, toe cap, sole and laces."""
+
+    def look(spec: Spec, size: int) -> Material:
+        rows = shoes.ROWS
+        return fabrics.atlas(spec.name, [
+            (*rows["upper"], upper, upper_colour),
+            (*rows["cap"], upper, cap_colour or upper_colour),
+            (*rows["sole"], "rubber", sole_colour),
+            (*rows["laces"], "cord", lace_colour),
+        ], size, stitches=(0.5 + 0.5 * 0.12, 0.3 + 0.2 * 0.2))  # fmt: skip
+
+    return look
 
 
 def _dress(body: AuthoringBody) -> Piece:
@@ -163,11 +178,14 @@ SPECS = [
     Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
-    Spec("shoes", "footwear", lambda b: _tights(b, shoes, 0.006), "leather", "brown", 0.008, 30, ("shoes", "boots")),  # noqa: E501
+    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.008, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "cream", "dark brown")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 320, (0.08, 0.14), 0.025, (0.003, 0.008), 4), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
+    Spec("hair-buzz", "hair", lambda b: join([hair.base_cap(b, 0.0015), hair.grow_cards(b, hair.flow_crown(sweep=0.0), 1400, (0.006, 0.012), 0.008, (0.0015, 0.003), 2)]), "hair", "dark brown hair", 0.0, 70, ("hair", "buzz", "short", "men")),  # noqa: E501
+    Spec("hair-bob", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.06, 0.1), 0.025, (0.004, 0.014), 4), hair.hang_cards(b, hair.flow_parted())]), "hair", "auburn hair", 0.0, 70, ("hair", "bob", "fringe")),  # noqa: E501
+    Spec("hair-bun", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied((0.0, 0.06, 0.075)), 360, (0.08, 0.14), 0.025, (0.003, 0.007), 4), hair.bun(b)]), "hair", "grey hair", 0.0, 70, ("hair", "bun", "tied back", "elderly")),  # noqa: E501
     Spec("eyebrows", "face", face.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501
     Spec("eyebrows-blond", "face", face.eyebrows, "hair", "blond hair", 0.0, 5, ("eyebrows", "blond"), False),  # noqa: E501
     Spec("eyebrows-black", "face", face.eyebrows, "hair", "black hair", 0.0, 5, ("eyebrows", "black"), False),  # noqa: E501
@@ -180,7 +198,9 @@ BY_NAME = {s.name: s for s in SPECS}
 def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
     """A built-in Garment from its recipe on the authoring body."""
     piece = spec.make(body)
-    if spec.category in ("hair", "face"):
+    if spec.look is not None:
+        material = spec.look(spec, texture_size)
+    elif spec.category in ("hair", "face"):
         material = textures.hair_material(spec, texture_size)
     else:
         material = fabrics.material(spec.fabric, spec.colour, texture_size, name=spec.name)

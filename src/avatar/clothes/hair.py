@@ -389,3 +389,109 @@ def orient_up(mesh: Mesh) -> Mesh:
     fuv = faces.copy() if mesh.face_uvs is None else mesh.face_uvs.copy()
     fuv[flip] = fuv[flip][:, [2, 1, 0, 3]]
     return Mesh(mesh.vertices, faces, mesh.uvs, fuv)
+
+
+# ---------------------------------------------------------------------------- hanging hair
+
+
+def hang_cards(
+    body: AuthoringBody,
+    flow,
+    count: int = 520,
+    end: tuple[float, float] = (-0.09, -0.075),
+    fringe: float | None = 0.035,
+    width: float = 0.022,
+    lift=(0.004, 0.02),
+    segments: int = 10,
+    seed: int = 3,
+) -> Piece:
+    """Hair that falls: cards rooted inside the hairline, combed along ``flow`` over the
+    scalp, then bending down under their weight, never nearer the skin than their lift, cut
+    level at ``end`` (low, high) m relative to eye height (a bob's blunt line; each card
+    ends at a random height in that range). Roots facing the face (within 50 degrees of the
+    front) make a ``fringe`` ending that far above the eyes (None: parted off the face).
+    """
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
+    roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
+    front = around(roots, centre) < 50
+    depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
+    height = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
+    height *= rng.uniform(0.6, 1.0, count)
+    stop = eye_z + rng.uniform(end[0], end[1], count)
+    if fringe is not None:
+        stop[front] = eye_z + fringe + rng.uniform(-0.004, 0.004, front.sum())
+    length = 0.35
+    step = length / segments
+    rows, point = [roots], roots
+    for k in range(1, segments + 1):
+        along = _tangent(body, point, flow(point, centre, eye_z))
+        fall = np.clip(k / segments * 2.2, 0, 1)  # combed over the crown, then hanging
+        direction = along * (1 - fall)[..., None] + np.array([0, 0, -1.0]) * fall
+        direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
+        gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
+        point = _off_skin(body, point + step * direction, gap)
+        rows.append(point)
+    path = np.stack(rows, 1)  # (N, K+1, 3)
+    path = _cut_at(path, stop)
+    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    return _card_piece(body, path, normal, width, rng)
+
+
+def _off_skin(body: AuthoringBody, points: np.ndarray, gap) -> np.ndarray:
+    """(N, 3) points moved out along the nearest skin vertices' normals until each is at
+    least ``gap`` m ((N,) or a float) outside them; points farther out stay where they are."""
+    gap = np.broadcast_to(np.asarray(gap, np.float64), (len(points),))
+    _, i = body.skin_tree.query(points, k=6)
+    out = points.astype(np.float64).copy()
+    for k in range(i.shape[1]):
+        skin, n = body.vertices[i[:, k]], body.skin_normals[i[:, k]].astype(np.float64)
+        d = np.einsum("nd,nd->n", out - skin, n)
+        out += np.clip(gap - d, 0, None)[:, None] * n
+    return out
+
+
+def _cut_at(path: np.ndarray, stop: np.ndarray) -> np.ndarray:
+    """(N, K, 3) paths resampled over their length down to where each first reaches the
+    height ``stop`` (N,) (the whole path when it never does)."""
+    n, k = path.shape[:2]
+    seg = np.linalg.norm(np.diff(path, axis=1), axis=2)
+    arc = np.concatenate([np.zeros((n, 1)), np.cumsum(seg, axis=1)], 1)  # (N, K)
+    below = path[..., 2] <= stop[:, None]
+    first = np.where(below.any(axis=1), below.argmax(axis=1), k - 1)
+    j = np.maximum(first, 1)
+    rows = np.arange(n)
+    z0, z1 = path[rows, j - 1, 2], path[rows, j, 2]
+    frac = np.where(below.any(axis=1), np.clip((z0 - stop) / np.maximum(z0 - z1, 1e-9), 0, 1), 1)
+    total = arc[rows, j - 1] + frac * (arc[rows, j] - arc[rows, j - 1])
+    t = np.linspace(0, 1, k)[None, :] * total[:, None]
+    out = np.empty_like(path)
+    for c in range(3):
+        out[..., c] = np.stack([np.interp(t[r], arc[r], path[r, :, c]) for r in range(n)])
+    return out
+
+
+def bun(body: AuthoringBody, radius: float = 0.032, count: int = 90, seed: int = 4) -> Piece:
+    """A bun: strand cards wound round a ball pinned high on the back of the head (as
+    hair wound into a knot), every card outside the scalp."""
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
+    skull = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"]
+    anchor = np.array([0.0, skull[:, 1].max() - 0.02, eye_z + 0.075])
+    _, i = body.skin_tree.query(anchor)
+    normal = body.skin_normals[i].astype(np.float64)
+    ball = body.vertices[i] + normal * (radius * 0.85)
+    k = 12
+    # Each card winds half way round the ball on a random great circle.
+    axis = rng.normal(size=(count, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    a = np.cross(axis, rng.normal(size=(count, 3)))
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b = np.cross(axis, a)
+    t = rng.uniform(0, 2 * np.pi, count)[:, None] + np.linspace(0, np.pi * 1.1, k)[None, :]
+    r = radius * rng.uniform(0.85, 1.05, count)[:, None, None]
+    path = ball + r * (np.cos(t)[..., None] * a[:, None] + np.sin(t)[..., None] * b[:, None])
+    flat = _off_skin(body, path.reshape(-1, 3), 0.004).reshape(path.shape)
+    outward = flat - ball
+    outward /= np.linalg.norm(outward, axis=-1, keepdims=True)
+    return _card_piece(body, flat, outward, 0.018, rng)

@@ -41,6 +41,9 @@ FABRICS = {
     "lycra": Fabric("lycra", "knit", 160, 0.6, 0.35, 0.06),
     "wool": Fabric("wool", "twill", 60, 2.2, 0.95, 0.25),
     "hair": Fabric("hair", "strands", 220, 2.5, 0.5, 0.6),
+    "rubber": Fabric("rubber", "grain", 90, 0.8, 0.75, 0.05),
+    "calf": Fabric("calf", "grain", 220, 0.25, 0.35, 0.04),  # smooth shoe leather
+    "cord": Fabric("cord", "twill", 40, 2.5, 0.9, 0.3),
 }
 
 COLOURS = {
@@ -50,7 +53,10 @@ COLOURS = {
     "brown": (0.18, 0.09, 0.04), "beige": (0.62, 0.52, 0.4), "sky": (0.3, 0.5, 0.75),
     "yellow": (0.8, 0.6, 0.08), "pink": (0.75, 0.35, 0.45), "teal": (0.04, 0.3, 0.32),
     "dark brown hair": (0.05, 0.025, 0.012), "blond hair": (0.45, 0.32, 0.15),
-    "black hair": (0.012, 0.01, 0.01),
+    "black hair": (0.012, 0.01, 0.01), "tan": (0.33, 0.17, 0.07), "cream": (0.75, 0.72, 0.64),
+    "charcoal": (0.06, 0.06, 0.065), "burgundy": (0.22, 0.02, 0.04),
+    "auburn hair": (0.14, 0.045, 0.018), "grey hair": (0.36, 0.35, 0.34),
+    "dark brown": (0.07, 0.035, 0.018),
 }  # fmt: skip
 
 
@@ -157,4 +163,40 @@ def material(
         alpha_mode=mode,
         double_sided=alpha is not None,
         extras={"fabric": fabric_name, "colour": label, "tile_metres": TILE_METRES},
+    )
+
+
+def atlas(
+    name: str,
+    rows: list[tuple[float, float, str, object]],
+    size: int = 1024,
+    stitches: tuple[float, ...] = (),
+) -> Material:
+    """One Material whose texture is cut in horizontal bands, each its own fabric and colour:
+    ``rows`` of (v0, v1, fabric, colour) with v in [0, 1] (v up). For garments made of
+    several materials (a shoe's leather, sole rubber and laces) that must stay one part.
+    stitches: v heights where a dashed seam of light thread is drawn across the texture.
+    """
+    colour = np.zeros((size, size, 3), np.uint8)
+    normal = np.zeros((size, size, 3), np.uint8)
+    rough = np.zeros((size, size), np.uint8)
+    for v0, v1, fabric, tint in rows:
+        r0, r1 = int(round((1 - v1) * size)), int(round((1 - v0) * size))
+        _, n, r = maps(fabric, size)
+        colour[r0:r1] = colour_map(fabric, tint, size)[r0:r1]
+        normal[r0:r1], rough[r0:r1] = n[r0:r1], r[r0:r1]
+    for v in stitches:  # dashes 6 px long, 2 px thick, a thread's height in the normal map
+        row = int(round((1 - v) * size))
+        dash = (np.arange(size) // 6) % 2 == 0
+        colour[row : row + 2, dash] = (np.asarray(colour[row : row + 2, dash], np.float32) * 0.4
+                                       + 150).astype(np.uint8)  # fmt: skip
+        normal[row, dash] = (128, 170, 230)
+        normal[row + 1, dash] = (128, 86, 230)
+    return Material(
+        name=name,
+        base_color_texture=colour,
+        normal_texture=normal,
+        roughness=1.0,
+        roughness_texture=rough,
+        extras={"fabric": "atlas", "rows": [[v0, v1, f] for v0, v1, f, _ in rows]},
     )
