@@ -56,6 +56,20 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rig", default="default", help="Avatar rig to drive")
     p.add_argument("-o", "--output", metavar="TAKE.bvh", help="record onto the rig as BVH")
     p.set_defaults(run=run_serve)
+    p = cmds.add_parser("video", help="motion from a video (MediaPipe Pose) onto a character",
+                        description="Estimate the body's motion in a video with MediaPipe Pose "
+                        "(pip install 'avatar[mocap]'), solve it onto an Avatar rig and write "
+                        "the animated (dressed) character as GLB/glTF/FBX/... or the motion "
+                        "as BVH. World landmarks have no travel: the character moves on the "
+                        "spot.")  # fmt: skip
+    p.add_argument("clip", metavar="CLIP.mp4", help="a video file OpenCV can read")
+    p.add_argument("--rig", default="default", help="Avatar rig to drive")
+    p.add_argument("--wear", action="append", default=[], metavar="NAME|PATH",
+                   help="a garment to wear (avatar clothes list); repeatable")  # fmt: skip
+    p.add_argument("--frames", type=paths.positive_number, default=None,
+                   help="use at most this many frames")  # fmt: skip
+    p.add_argument("-o", "--output", required=True, metavar="OUT.glb|OUT.bvh")
+    p.set_defaults(run=run_video)
 
 
 def run_record(args: argparse.Namespace) -> int:
@@ -96,6 +110,31 @@ def run_serve(args: argparse.Namespace) -> int:
         take = record.to_animation(poses, human.skeleton)
         bvh.save(args.output, human.skeleton, take)
         print(f"{args.output}: {take.frames} frames at {take.fps:g} fps")
+    return 0
+
+
+def run_video(args: argparse.Namespace) -> int:
+    from avatar import export
+    from avatar.clothes import library
+    from avatar.mocap import video
+
+    clip = paths.input_file(args.clip, "video")
+    out = paths.output_file(args.output)
+    if out.suffix.lower() not in export.WRITERS:
+        raise ParameterError(f"{args.output}: unknown output format; use one of "
+                             f"{', '.join(export.WRITERS)}")  # fmt: skip
+    for name in args.wear:  # fail early, naming the unknown garment
+        library.find_garment(name)
+    human = Human(rig=args.rig)
+    if args.wear:
+        human = human.dressed(*args.wear)
+    most = None if args.frames is None else int(args.frames)
+    pose = video.estimate(clip, most)
+    animation = video.solve(pose, human.skeleton)
+    found = int(pose.found.sum())
+    export.save(human, out, animation, animation_name=clip.stem)
+    print(f"{out}: {animation.frames} frames at {animation.fps:g} fps on the {args.rig} rig "
+          f"(a person found in {found} of {len(pose.points)} frames)")  # fmt: skip
     return 0
 
 

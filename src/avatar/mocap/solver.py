@@ -259,9 +259,13 @@ class PoseSolver:
             t = (b[il] + b[ir]) / 2 - r @ ((a[il] + a[ir]) / 2)
         else:
             t = cb - r @ ca
-        t = t + np.array([0.0, 0.0, self._lift(f, s)])
+        lift = np.array([0.0, 0.0, self._lift(f, s)])
         self._finish(f, 0, rest, r)
-        f.heads[0] = self._root = t
+        f.heads[0] = self._root = t + lift
+        if s != 1.0 or lift[2] != 0.0:
+            # Every later step compares keypoints with bone heads: put them in the rig's
+            # space, as the root was (scaled to the rig, on its floor).
+            f.p = f.p * s + lift
 
     def _lift(self, f: _Frame, s: float) -> float:
         floor = self.settings.floor
