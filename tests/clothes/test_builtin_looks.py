@@ -260,3 +260,23 @@ def test_bun_sits_high_on_the_back_of_the_head(body):
     assert len(behind) > 200
     assert behind[:, 2].mean() > eye_z + 0.04
     assert np.ptp(behind[:, 0]) < 0.1  # a knot, not a curtain
+
+
+def test_brows_are_dense_and_lashes_full():
+    """Brows: the core of the shape is mostly covered by hairs (a brow, not a pencil line);
+    lashes: many separate strands half way to the tips, most of the row covered."""
+    alpha = textures.brow_alpha(512) / 255
+    u = (np.arange(512) + 0.5) / 512
+    centre, half = textures.brow_shape(np.clip((u - 0.03) / 0.85, 0, 1))
+    core = np.zeros_like(alpha, bool)
+    for j in range(60, 400):
+        core[int((1 - centre[j] - 0.6 * half[j]) * 512):int((1 - centre[j] + 0.6 * half[j]) * 512),
+             j] = True  # fmt: skip
+    assert alpha[core].mean() > 0.75
+    lashes = textures.lash_alpha(512) / 255
+    row = lashes[128] > 0.5
+    assert np.count_nonzero(row[1:] & ~row[:-1]) > 50 and lashes[128].mean() > 0.5
+    blond = textures.hair_material(builtin.BY_NAME["eyebrows-blond"], 64).base_color_texture
+    hair_blond = textures.hair_material(builtin.BY_NAME["hair-long"], 64).base_color_texture
+    shown = [t[t[..., 3] > 128][:, :3].mean() for t in (blond, hair_blond)]
+    assert shown[0] < 0.85 * shown[1]  # a shade deeper than the hair: brows read on fair skin

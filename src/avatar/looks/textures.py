@@ -78,8 +78,8 @@ def lash_alpha(size: int, seed: int = 0) -> np.ndarray:
     half = size // 2
     canvas = np.zeros((size, size), np.float32)
     for root_row, count, reach, density in (
-        (half - 1.0, 170, 1.0, 1.0),
-        (size - 1.0, 90, 0.55, 0.7),
+        (half - 1.0, 300, 1.0, 1.0),
+        (size - 1.0, 140, 0.55, 0.75),
     ):
         for i in range(count):
             u = (i + rng.uniform(0.1, 0.9)) / count
@@ -90,7 +90,7 @@ def lash_alpha(size: int, seed: int = 0) -> np.ndarray:
             fan = 0.45 * (u - 0.5) + rng.normal(0, 0.03)  # radians off straight up
             direction = (np.sin(fan), -np.cos(fan))  # up the image (towards the tips)
             points = _curve((u * size, root_row), direction, length, 0.15 * np.sign(fan))
-            width = np.linspace(0.011, 0.002, len(points)) * size
+            width = np.linspace(0.012, 0.0025, len(points)) * size
             stroke(canvas, points, np.maximum(width, 0.7), rng.uniform(0.9, 1.0))
         line = np.linspace(1, 0, max(size // 25, 2)) ** 1.2  # the lash line at the lid margin
         rows = int(root_row) - np.arange(len(line))
@@ -106,17 +106,17 @@ def brow_shape(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         + 0.18 * np.sin(np.pi / 2 * np.clip(u / 0.65, 0, 1))
         - 0.45 * np.clip(u - 0.65, 0, 1) ** 1.3
     )
-    half = 0.17 * (1 - 0.72 * u) * np.sqrt(np.clip(u / 0.05, 0, 1))
+    half = 0.2 * (1 - 0.68 * u) * np.sqrt(np.clip(u / 0.05, 0, 1))
     return centre, half * np.clip((1 - u) / 0.1, 0, 1) ** 0.6
 
 
 def brow_alpha(size: int, seed: int = 0) -> np.ndarray:
-    """(S, S) uint8 alpha of one eyebrow: over a thousand short slanted hairs, upright at
-    the head and sweeping outward along the body; lower hairs grow up and out, upper ones
-    out and down, and the edges thin out instead of ending in a hard line."""
+    """(S, S) uint8 alpha of one eyebrow: some three thousand short slanted hairs, upright
+    at the head and sweeping outward along the body; lower hairs grow up and out, upper
+    ones out and down, and the edges thin out instead of ending in a hard line."""
     rng = np.random.default_rng([seed, size, 7])
     canvas = np.zeros((size, size), np.float32)
-    u = rng.uniform(0.0, 1.0, 1600) ** 0.85
+    u = rng.uniform(0.0, 1.0, 3200) ** 0.85
     centre, half = brow_shape(u)
     across = rng.uniform(-1.2, 1.2, len(u))  # -1 lower edge, +1 upper edge
     v = centre + half * across
@@ -132,7 +132,7 @@ def brow_alpha(size: int, seed: int = 0) -> np.ndarray:
         length = size * rng.uniform(0.06, 0.1) * (1 - 0.35 * ui)
         start = ((0.03 + 0.85 * ui) * size, (1 - vi) * size)  # room for the tail's hairs
         points = _curve(start, direction, length, rng.normal(-0.2, 0.1), samples=4)
-        width = np.linspace(0.006, 0.0015, len(points)) * size * (1 - 0.3 * ui)
+        width = np.linspace(0.0075, 0.002, len(points)) * size * (1 - 0.3 * ui)
         stroke(canvas, points, np.maximum(width, 0.6), oi)
     return np.round(np.clip(canvas, 0, 1) * 255).astype(np.uint8)
 
@@ -183,6 +183,10 @@ def hair_material(spec, size: int = 1024) -> Material:
         alpha, mode, shade = strand_alpha(size), "MASK", strand_shade(size)
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
     rgb = np.asarray(fabrics.COLOURS[spec.colour])[None, None, :] * shade[..., None]
+    if spec.name.startswith("eyebrows"):
+        # Brow hairs are coarser and darker than scalp hair of the same colour: blond brows
+        # a shade deeper, so they read against fair skin.
+        rgb = rgb * 0.5
     colour = np.concatenate([fabrics.srgb(rgb), alpha[..., None]], -1)
     # Hair is a fibre, not a mirror: a weaker specular keeps dark hair from glaring white.
     extras = {**m.extras, "specular": 0.3}
