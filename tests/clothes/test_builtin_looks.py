@@ -280,3 +280,42 @@ def test_brows_are_dense_and_lashes_full():
     hair_blond = textures.hair_material(builtin.BY_NAME["hair-long"], 64).base_color_texture
     shown = [t[t[..., 3] > 128][:, :3].mean() for t in (blond, hair_blond)]
     assert shown[0] < 0.85 * shown[1]  # a shade deeper than the hair: brows read on fair skin
+
+
+# ---------------------------------------------------------------------------- bands, cuffs
+
+
+def test_banded_adds_a_raised_band_and_a_lip_along_open_edges():
+    from avatar.clothes.authoring import banded, with_box_uvs
+    from avatar.mesh import Mesh
+
+    x, y = np.meshgrid(np.linspace(0, 0.1, 11), np.linspace(0, 0.1, 11))
+    points = np.stack([x.ravel(), y.ravel(), np.zeros(x.size)], 1).astype(np.float32)
+    ij = np.arange(121).reshape(11, 11)
+    faces = np.stack([ij[:-1, :-1], ij[:-1, 1:], ij[1:, 1:], ij[1:, :-1]], -1).reshape(-1, 4)
+    flat = with_box_uvs(Mesh(points, faces.astype(np.int32)))
+    out = banded(flat, width=0.015, lift=0.002)
+    assert out.face_uvs.shape == out.faces.shape and out.uvs.shape[0] > flat.uvs.shape[0]
+    lifted = out.vertices[121:]
+    assert np.allclose(np.abs(lifted[:, 2]), 0.002, atol=1e-6)  # a layer 2 mm off the cloth
+    band_faces = 100 - 64  # faces within 1.5 cm (one face and a half) of the edge
+    assert len(out.faces) == 100 + band_faces + 40  # + one lip quad per open edge
+    # The original edge is closed by the lip: the only open edges are the band's inner edge.
+    edges, _ = boundary_edges(out.faces)
+    assert (np.unique(edges) >= 121).all()
+
+
+def test_tshirt_neckline_and_hem_have_bands_and_long_sleeves_end_at_the_wrist(body):
+    from avatar.clothes import regions
+
+    tshirt = builtin.BY_NAME["tshirt"].make(body).mesh
+    edges, _ = boundary_edges(tshirt.faces)
+    rim = tshirt.vertices[np.unique(edges)]
+    # The open edges lie on the raised band: each has cloth 1-2 mm beneath it.
+    d, _ = body.skin_tree.query(rim)
+    plain = builtin._tights(body, builtin.top(0.3), builtin.sleeve_ease(0.007, 0.02)).mesh
+    d_plain, _ = body.skin_tree.query(plain.vertices[np.unique(boundary_edges(plain.faces)[0])])
+    assert np.median(d) > np.median(d_plain) + 0.001
+    sleeve = builtin.BY_NAME["longsleeve"].make(body).mesh
+    arm, _ = regions.limb_coordinates(sleeve.vertices.astype(np.float64), body.marks)
+    assert 0.9 < np.nanmax(arm) <= 1.0  # to the wrist, not over the hand

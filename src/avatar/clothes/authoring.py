@@ -285,3 +285,42 @@ def covered_skin(body: AuthoringBody, mesh: Mesh, reach: float = 0.02) -> np.nda
     tree = cKDTree(mesh.vertices)
     d, _ = tree.query(body.vertices[:BODY_VERTICES], distance_upper_bound=reach)
     return np.flatnonzero(np.isfinite(d)).astype(np.int32)
+
+
+def banded(mesh: Mesh, width: float = 0.015, lift: float = 0.0015) -> Mesh:
+    """The mesh with a band along every open edge (neckline rib, hem, cuffs): the faces
+    within ``width`` m of an edge again, ``lift`` m further out, and a lip joining the edge
+    to the band's, so the edge has a thickness and the band stands proud of the cloth.
+
+    mesh: an outward-facing garment surface with per-corner UVs (``with_box_uvs``); the
+    band's faces keep the UVs of the faces they copy. Returns a new Mesh.
+    """
+    assert mesh.uvs is not None and mesh.face_uvs is not None, "banded needs per-corner UVs"
+    edges, _ = boundary_edges(mesh.faces)
+    if len(edges) == 0:
+        return mesh
+    v = mesh.vertices.astype(np.float64)
+    rim = np.unique(edges)
+    near, _ = cKDTree(v[rim]).query(v)
+    inside = near < width
+    band = np.flatnonzero(inside[mesh.faces].all(axis=1))
+    normals = vertex_normals(mesh.vertices, mesh.faces).astype(np.float64)
+    n = len(v)
+    copied = np.unique(np.concatenate([mesh.faces[band].ravel(), rim]))  # only these lift
+    new = np.full(n, -1)
+    new[copied] = n + np.arange(len(copied))
+    lifted = v[copied] + lift * normals[copied]
+    faces = [mesh.faces, new[mesh.faces[band]]]
+    face_uvs = [mesh.face_uvs, mesh.face_uvs[band]]
+    # The lip: a quad per open edge, from the edge up to the band's edge.
+    lip = np.stack([edges[:, 1], edges[:, 0], new[edges[:, 0]], new[edges[:, 1]]], 1)
+    faces.append(_pad(lip, mesh.faces.shape[1]))
+    corner_uv = np.zeros((n, 2), np.float32)
+    corner_uv[mesh.faces.ravel()] = mesh.uvs[mesh.face_uvs.ravel()]
+    source = np.stack([edges[:, 1], edges[:, 0], edges[:, 0], edges[:, 1]], 1)
+    uvs = np.concatenate([mesh.uvs, corner_uv[source.ravel()]])
+    lip_uvs = len(mesh.uvs) + np.arange(lip.size, dtype=np.int32).reshape(lip.shape)
+    face_uvs.append(_pad(lip_uvs, mesh.faces.shape[1]))
+    return Mesh(np.concatenate([v, lifted]).astype(np.float32),
+                np.concatenate(faces).astype(np.int32), uvs.astype(np.float32),
+                np.concatenate(face_uvs).astype(np.int32))  # fmt: skip

@@ -17,6 +17,7 @@ from avatar.clothes import face, hair, shoes
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
+    banded,
     bound,
     covered_skin,
     cut,
@@ -47,10 +48,15 @@ class Spec:
     look: Callable[[Spec, int], Material] | None = None
 
 
-def _tights(body: AuthoringBody, keep_fn, ease) -> Piece:
+def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0) -> Piece:
+    """A garment cut from ``helper-tights``; ``band`` > 0: a rib/hem band that wide (m)
+    along every open edge (``authoring.banded``)."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
-    return bound(body, cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX), faces)
+    mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX)
+    if band:
+        mesh = banded(mesh, band)
+    return bound(body, mesh, faces)
 
 
 def _skirt(body: AuthoringBody, bottom_z: float, ease) -> Piece:
@@ -165,11 +171,11 @@ EYELASH_GROUPS = (
 )
 
 SPECS = [
-    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02)), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
-    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.97), sleeve_ease(0.006, 0.012)), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
+    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
+    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
     Spec("jacket", "tops", lambda b: _tights(b, top(0.98, neck=-0.03, hem=-0.03), sleeve_ease(0.016, 0.01)), "leather", "black", 0.003, 60, ("jacket", "outerwear")),  # noqa: E501
-    Spec("hoodie", "tops", lambda b: _tights(b, top(0.97, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012)), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
+    Spec("hoodie", "tops", lambda b: _tights(b, top(0.95, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012), 0.03), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
     Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
