@@ -29,14 +29,37 @@ def _assets_available() -> bool:
 
 @pytest.mark.skipif(not all(shutil.which(t) for t in TOOLS), reason="needs blender, Xvfb, xdotool")
 @pytest.mark.skipif(not _assets_available(), reason="needs the MakeHuman assets")
-@pytest.mark.timeout(300)
-def test_create_button_makes_a_character(tmp_path):
+@pytest.mark.timeout(700)
+def test_create_drag_undo_wear_and_apply_in_a_real_window(tmp_path):
     run = subprocess.run([str(HERE / "run_ui_smoke.sh"), str(tmp_path)],
-                         capture_output=True, text=True, timeout=280)  # fmt: skip
-    state = json.loads((tmp_path / "state.json").read_text())
+                         capture_output=True, text=True, timeout=680)  # fmt: skip
     assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
-    assert state["panel"]
-    ((name, recipe),) = state["characters"].items()
-    assert recipe["rig"] == "default" and recipe["params"]["gender"] == 0.5
-    assert state["meshes"]["body"] == 13380
-    assert (tmp_path / "after-create.png").stat().st_size > 50_000
+
+    def state(step):
+        data = json.loads((tmp_path / f"state-{step}.json").read_text())
+        ((name, recipe),) = data["characters"].items()
+        return data, recipe
+
+    created, recipe = state("settled")
+    assert created["panel"] and recipe["rig"] == "default"
+    assert created["meshes"]["body"] == 13380
+    assert {"hair-short", "eyebrows", "eyelashes"} <= set(created["shown"])  # by default
+    # A drag on the Weight slider changed the body shown, with no button pressed.
+    dragged, recipe = state("after-drag")
+    assert recipe["params"]["weight"] > 0.6
+    assert dragged["shown"]["body"] != created["shown"]["body"]
+    # Edit > Undo in the window brings the previous body back.
+    undone, recipe = state("after-undo")
+    assert recipe["params"].get("weight", 0.5) == 0.5
+    assert undone["shown"]["body"] == created["shown"]["body"]
+    # Two clicks in the Dress panel's grid: both garments worn, as objects.
+    worn, recipe = state("after-wear")
+    assert {"tshirt", "jeans"} <= set(recipe["clothes"]) and {"tshirt", "jeans"} <= set(
+        worn["shown"]
+    )
+    # Apply (Motion) on the dressed character: 30 frames played, the report kept.
+    moved, recipe = state("after-motion")
+    assert list(moved["actions"].values()) == [[1, 30]]
+    assert "bones mapped" in next(iter(moved["reports"].values()))
+    for shot in ("after-create", "after-drag", "after-wear", "after-motion"):
+        assert (tmp_path / f"{shot}.png").stat().st_size > 50_000

@@ -7,6 +7,9 @@ in $AVATAR_UI_OUT, polling on a timer so Blender's UI stays live between them:
   screen coordinates (origin top-left), for xdotool.
 - ``request-shot-NAME`` -> ``NAME.png`` (Blender's screenshot operator) and ``state.json``
   (the characters in the scene, with their stored recipes).
+- ``request-undo`` -> Edit > Undo in the window (``bpy.ops.ed.undo``).
+- ``request-bvh`` -> the Motion panel's BVH set to ``$AVATAR_UI_BVH`` (30 frames), as
+  typing a path would.
 - ``request-quit`` -> quit Blender.
 """
 
@@ -58,6 +61,13 @@ def serve():
             return None
         if name.startswith("request-shot-"):
             _screenshot(name[len("request-shot-") :])
+        if name == "request-undo":
+            window, area = _view3d()
+            with bpy.context.temp_override(window=window, area=area):
+                bpy.ops.ed.undo()
+        if name == "request-bvh":
+            bpy.context.scene.avatar.bvh_path = os.environ.get("AVATAR_UI_BVH", "")
+            bpy.context.scene.avatar.frame_end = 30
     return 0.25
 
 
@@ -81,9 +91,33 @@ def _capture(name):
         if "avatar_recipe" in o.keys()
     }
     meshes = {o.name: len(o.data.vertices) for o in bpy.data.objects if o.type == "MESH"}
+    # What the viewport shows of each part: the sum of its evaluated vertex coordinates.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    shown = {}
+    for o in bpy.data.objects:
+        if o.type == "MESH" and "avatar_part" in o.keys():
+            data = o.evaluated_get(depsgraph).data
+            shown[o["avatar_part"]] = round(sum(abs(c) for v in data.vertices for c in v.co), 3)
+    actions = {
+        o.name: [round(f) for f in o.animation_data.action.frame_range]
+        for o in bpy.data.objects
+        if o.animation_data and o.animation_data.action
+    }
+    reports = {
+        o.name: o.get("avatar_motion_report", "")
+        for o in bpy.data.objects
+        if "avatar_recipe" in o.keys()
+    }
     _write(
         "state.json",
-        {"characters": characters, "meshes": meshes, "panel": hasattr(bpy.types, "AVATAR_PT_body")},
+        {
+            "characters": characters,
+            "meshes": meshes,
+            "shown": shown,
+            "actions": actions,
+            "reports": reports,
+            "panel": hasattr(bpy.types, "AVATAR_PT_body"),
+        },
     )
     _write(f"done-{name}", {})
 
