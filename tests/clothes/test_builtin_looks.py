@@ -319,3 +319,55 @@ def test_tshirt_neckline_and_hem_have_bands_and_long_sleeves_end_at_the_wrist(bo
     sleeve = builtin.BY_NAME["longsleeve"].make(body).mesh
     arm, _ = regions.limb_coordinates(sleeve.vertices.astype(np.float64), body.marks)
     assert 0.9 < np.nanmax(arm) <= 1.0  # to the wrist, not over the hand
+
+
+# ---------------------------------------------------------------------------- dress
+
+
+def _aureola_vertices(model) -> np.ndarray:
+    """Skin vertices inside MakeHuman's aureolae mask (by their UVs)."""
+    from avatar.looks import skin
+
+    mask = skin.region_masks(256)["aureolae"]
+    base = model.base
+    rows = base.face_groups["body"]
+    corners, uv = base.faces[rows].ravel(), base.uvs[base.face_uvs[rows].ravel()]
+    r = np.clip(((1 - uv[:, 1]) * 256).astype(int), 0, 255)
+    c = np.clip((uv[:, 0] * 256).astype(int), 0, 255)
+    return np.unique(corners[mask[r, c] > 0.5])
+
+
+def _forward_hits(origins: np.ndarray, mesh) -> np.ndarray:
+    """(N,) bool: a ray from each origin towards the front (-Y) crosses the mesh."""
+    quads = mesh.faces
+    tris = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    t = mesh.vertices[tris].astype(np.float64)
+    p = origins.astype(np.float64)
+    # Project on the XZ plane: a forward ray hits a triangle in front that covers it in 2D.
+    a, b, c = t[:, 0, [0, 2]], t[:, 1, [0, 2]], t[:, 2, [0, 2]]
+    q = p[:, None, [0, 2]]
+    d = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+    d = np.where(np.abs(d) < 1e-12, 1e-12, d)
+    dx, dz = q[..., 0] - c[:, 0], q[..., 1] - c[:, 1]
+    w0 = ((b[:, 1] - c[:, 1]) * dx + (c[:, 0] - b[:, 0]) * dz) / d
+    w1 = ((c[:, 1] - a[:, 1]) * dx + (a[:, 0] - c[:, 0]) * dz) / d
+    w2 = 1 - w0 - w1
+    y = w0 * t[:, 0, 1] + w1 * t[:, 1, 1] + w2 * t[:, 2, 1]
+    inside = (w0 >= 0) & (w1 >= 0) & (w2 >= 0) & (y < p[:, None, 1])
+    return inside.any(axis=1)
+
+
+def test_dress_has_straps_and_covers_the_chest_at_every_size(model):
+    nipples = _aureola_vertices(model)
+    assert len(nipples) > 10
+    for params in ({"gender": 0.0}, {"gender": 0.0, "cupsize": 1.0, "weight": 1.0},
+                   {"gender": 0.0, "age": 0.2}, {"gender": 0.0, "cupsize": 1.0, "firmness": 0.0},
+                   {"gender": 0.3, "muscle": 1.0, "weight": 0.0}):  # fmt: skip
+        human = Human(params, model=model).dressed("dress")
+        dress = library.parts(human.outfit)[0].mesh
+        covered = _forward_hits(human.vertices[nipples], dress)
+        assert covered.all(), params
+    mesh = builtin.BY_NAME["dress"].make(library.authoring_body()).mesh
+    marks = library.authoring_body().marks
+    top = mesh.vertices[mesh.vertices[:, 2] > marks.neck[2] - 0.03]
+    assert (top[:, 0] > 0.05).any() and (top[:, 0] < -0.05).any()  # straps over both shoulders

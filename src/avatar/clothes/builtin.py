@@ -147,8 +147,13 @@ def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
     return look
 
 
+# A dress's bodice: the tank top's cut on wider straps, its neckline scooped 9 cm below the
+# neck joint in front (well above the bust at every size) and 7 cm at the back.
+dress_bodice = strapped(0.02, armhole=0.056, front=0.09, back=0.07)
+
+
 def _dress(body: AuthoringBody) -> Piece:
-    top_piece = _tights(body, bodice, 0.004)
+    top_piece = _tights(body, dress_bodice, 0.004, 0.012)
     skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.004, 0.05))
     return join([top_piece, skirt_piece])
 
