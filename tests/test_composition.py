@@ -120,8 +120,9 @@ def test_load_reads_back_what_save_wrote(tmp_path, model, suffix):
     if suffix == ".mhm":
         assert loaded.params == pytest.approx(model.defaults() | human.params)
         assert loaded.recipe.rig == "game_engine"
-    elif suffix == ".obj":
-        assert loaded.vertices.shape == (13380, 3)
+    elif suffix == ".obj":  # every part: the body's 13,380 vertices first, then the eyes
+        assert list(loaded.face_groups)[:2] == ["body", "eyes"]
+        assert np.unique(loaded.faces[loaded.face_groups["body"]]).max() == 13379
     elif suffix == ".bvh":
         skeleton, animation = loaded
         assert sorted(skeleton.names) == sorted(human.skeleton.names) and animation.frames == 1

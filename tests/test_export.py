@@ -66,8 +66,11 @@ def test_obj_writes_every_part_with_its_mtl_and_textures(tmp_path, model):
     path = avatar.save(human, tmp_path / "h.obj")
     mesh = obj.read(path)
     parts = sizing.sized(human.parts())
-    assert list(mesh.face_groups) == [p.name for p in parts] == ["body", "eyes", "teeth",
-                                                                 "tongue", "tshirt"]
+    assert (
+        list(mesh.face_groups)
+        == [p.name for p in parts]
+        == ["body", "eyes", "teeth", "tongue", "tshirt"]
+    )
     start = 0
     for part in parts:  # vertices in part order, each part's faces under its object
         count = len(part.mesh.vertices)
