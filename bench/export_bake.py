@@ -47,6 +47,7 @@ def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
     """(worst depth (m) of a garment vertex inside the body over every frame, frames with
     any vertex more than 1 mm inside), played back from the file alone."""
     from avatar.geometry import collision
+    from avatar.human import BODY_PART_GROUPS
     from avatar.io import gltf
     from avatar.rig import kinematics, skinning
 
@@ -55,7 +56,7 @@ def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
     keyed = file.morph_weights.get(name, {})
     world = kinematics.forward(file.skeleton, clip.rotations, clip.translations)
     parts = {p.name: p for p in file.parts}
-    garments = [p for n, p in parts.items() if n not in ("body", "eyes") and "_LOD" not in n]
+    garments = [p for n, p in parts.items() if n not in BODY_PART_GROUPS and "_LOD" not in n]
     worst, bad = 0.0, 0
     for t in range(clip.frames):
         matrices = kinematics.skinning_matrices(file.skeleton, world[t : t + 1])[0]
@@ -77,6 +78,7 @@ def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
 
 def main(argv: list[str]) -> None:
     import avatar
+    from avatar.human import BODY_PART_GROUPS
 
     seconds, fps = float(_arg(argv, "--seconds", "10")), float(_arg(argv, "--fps", "30"))
     wear = _arg(argv, "--wear", WEAR).split(",")
@@ -100,7 +102,8 @@ def main(argv: list[str]) -> None:
             start = time.perf_counter()
             avatar.save(human, path, clip, resolve_garments=resolve)
             seconds_taken = time.perf_counter() - start
-            shapes = {p.name: len(p.morphs) for p in avatar.load(path).parts[2:]}
+            shapes = {p.name: len(p.morphs) for p in avatar.load(path).parts
+                      if p.name not in BODY_PART_GROUPS}  # fmt: skip
             rows[name] = (seconds_taken, path.stat().st_size, shapes,
                           _played_penetration(path, faces))  # fmt: skip
     (plain_s, plain_b, _, plain_in), (baked_s, baked_b, shapes, baked_in) = rows.values()
