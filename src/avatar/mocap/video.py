@@ -15,6 +15,7 @@ the solver's confidence (below 0.5: the joint is held and relaxes to rest).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 from collections.abc import Callable, Iterator
@@ -56,13 +57,15 @@ class VideoPose:
 
 def _modules():
     """(cv2, mediapipe pose module), or AvatarError saying how to install them."""
+    os.environ.setdefault("GLOG_minloglevel", "2")  # MediaPipe's C++ info/warning lines
     try:
         import cv2
+
+        _protobuf_compat()  # before mediapipe's import, which already reads messages
         import mediapipe.python.solutions.pose as mp_pose
     except ImportError as exc:
         raise AvatarError(f"video capture needs OpenCV and MediaPipe: {INSTALL} "
                           f"({exc.name or exc} is missing)") from None  # fmt: skip
-    _protobuf_compat()
     return cv2, mp_pose
 
 
@@ -90,8 +93,9 @@ def frames(path: str | os.PathLike[str]) -> tuple[float, tuple[int, int], Iterat
     p = Path(path)
     if not p.is_file():
         raise FormatError(p, 0, "no such video file")
-    capture = cv2.VideoCapture(str(p))
-    ok, first = capture.read() if capture.isOpened() else (False, None)
+    with _quiet_stderr():  # FFmpeg logs its own complaint ("moov atom not found")
+        capture = cv2.VideoCapture(str(p))
+        ok, first = capture.read() if capture.isOpened() else (False, None)
     if not ok or first is None:
         capture.release()
         raise FormatError(p, 0, "not a video OpenCV can read (no decodable frame)")
@@ -111,6 +115,24 @@ def frames(path: str | os.PathLike[str]) -> tuple[float, tuple[int, int], Iterat
             capture.release()
 
     return fps, size, read()
+
+
+@contextlib.contextmanager
+def _quiet_stderr() -> Iterator[None]:
+    """Silence the process's stderr (file descriptor 2: C libraries) for a moment, so a bad
+    file gives Avatar's one-line error only."""
+    try:
+        saved = os.dup(2)
+    except OSError:
+        yield
+        return
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def estimate(path: str | os.PathLike[str], most: int | None = None,
