@@ -371,3 +371,45 @@ def test_dress_has_straps_and_covers_the_chest_at_every_size(model):
     marks = library.authoring_body().marks
     top = mesh.vertices[mesh.vertices[:, 2] > marks.neck[2] - 0.03]
     assert (top[:, 0] > 0.05).any() and (top[:, 0] < -0.05).any()  # straps over both shoulders
+
+
+# ---------------------------------------------------------------------------- hood, openings
+
+
+def test_hoodie_has_a_hood_lying_on_the_back(body):
+    mesh = builtin.BY_NAME["hoodie"].make(body).mesh
+    plain = builtin._tights(body, builtin.top(0.95, neck=-0.02, hem=-0.02),
+                            builtin.sleeve_ease(0.013, 0.012)).mesh  # fmt: skip
+    m = body.marks
+
+    def off_body(v):
+        back = (v[:, 1] > m.neck[1] + 0.02) & (v[:, 2] > m.neck[2] - 0.15) & (v[:, 2] < m.neck[2])
+        return np.percentile(body.skin_tree.query(v[back])[0], 95)
+
+    assert off_body(mesh.vertices) > off_body(plain.vertices) + 0.02  # a roll, not a shirt
+    front = mesh.vertices[(mesh.vertices[:, 1] < m.neck[1] - 0.06)]
+    assert np.percentile(body.skin_tree.query(front)[0], 95) < 0.04  # nothing bulky in front
+
+
+@pytest.mark.parametrize("name", ["jacket", "cardigan"])
+def test_jackets_and_cardigans_open_down_the_front(body, name):
+    mesh = builtin.BY_NAME[name].make(body).mesh
+    m = body.marks
+    v = mesh.vertices
+    middle = (np.abs(v[:, 0]) < 0.008) & (v[:, 1] < m.neck[1] - 0.04)
+    middle &= (v[:, 2] > m.hip[0, 2] + 0.05) & (v[:, 2] < m.chest_z)
+    assert not middle.any()  # the opening: no cloth on the midline of the front
+    sides = (np.abs(v[:, 0]) > 0.03) & (v[:, 1] < m.neck[1] - 0.04)
+    assert sides.sum() > 100
+
+
+def test_thirty_items_across_categories_with_variants():
+    specs = builtin.SPECS
+    assert len(specs) >= 30
+    footwear = {s.name for s in specs if s.category == "footwear"}
+    assert {"shoes", "shoes-black", "sneakers", "boots"} <= footwear
+    tags = {t for s in specs for t in s.tags}
+    assert {"children", "elderly"} <= tags
+    boots = builtin.BY_NAME["boots"].make(library.authoring_body()).mesh
+    shoes_mesh = builtin.BY_NAME["shoes"].make(library.authoring_body()).mesh
+    assert boots.vertices[:, 2].max() > shoes_mesh.vertices[:, 2].max() + 0.03  # above the ankle

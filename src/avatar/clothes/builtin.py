@@ -81,6 +81,17 @@ def top(sleeve: float, neck: float = 0.0, hem: float = 0.04):
     return keep
 
 
+def opened(keep_fn, gap: float = 0.012):
+    """A front opening: ``keep_fn``'s faces less a strip ``gap`` m either side of the
+    body's midline on the front (a jacket or cardigan worn open)."""
+
+    def keep(ff, m):
+        front = ff.centre[:, 1] < m.neck[1] - 0.02
+        return keep_fn(ff, m) & ~(front & (np.abs(ff.centre[:, 0]) < gap))
+
+    return keep
+
+
 def bottom(length: float, rise: float = 0.07):
     """Pelvis up to ``rise`` above the hip joints, legs to ``length`` along the leg."""
 
@@ -158,6 +169,29 @@ def _dress(body: AuthoringBody) -> Piece:
     return join([top_piece, skirt_piece])
 
 
+def _hood(body: AuthoringBody) -> Piece:
+    """A hood lying down on the back: the back of the neck and shoulders cut again and
+    puffed out into a soft roll (deepest in the middle), its rim banded."""
+    faces = body.group_faces("helper-tights")
+    m = body.marks
+    c = body.vertices[faces].mean(axis=1)
+    low, high = m.neck[2] - 0.2, m.neck[2] + 0.035
+    keep = (c[:, 1] > m.neck[1] - 0.01) & (c[:, 2] > low) & (c[:, 2] < high)
+    keep &= np.abs(c[:, 0]) < 0.14
+
+    def puff(p, arm, leg):
+        across = np.clip(1 - (p[:, 0] / 0.14) ** 2, 0, 1)
+        down = np.sin(np.pi * np.clip((p[:, 2] - low) / (high - low), 0, 1)) ** 0.7
+        return 0.012 + 0.035 * across * down
+
+    return bound(body, banded(cut(body, faces, keep, puff, relax=RELAX), 0.012), faces)
+
+
+def _hoodie(body: AuthoringBody) -> Piece:
+    top_piece = _tights(body, top(0.95, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012), 0.03)
+    return join([top_piece, _hood(body)])
+
+
 def _skirt_ease(body: AuthoringBody, base: float, extra: float):
     hip, knee = body.marks.hip[0, 2], body.marks.knee[0, 2]
     return lambda p, arm, leg: base + extra * np.clip((hip - p[:, 2]) / (hip - knee), 0, 1.5)
@@ -179,17 +213,22 @@ SPECS = [
     Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
-    Spec("jacket", "tops", lambda b: _tights(b, top(0.98, neck=-0.03, hem=-0.03), sleeve_ease(0.016, 0.01)), "leather", "black", 0.003, 60, ("jacket", "outerwear")),  # noqa: E501
-    Spec("hoodie", "tops", lambda b: _tights(b, top(0.95, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012), 0.03), "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
+    Spec("jacket", "tops", lambda b: _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
+    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.01), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
+    Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
     Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
+    Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
     Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03)), "cotton", "red", 0.0015, 36, ("skirt",)),  # noqa: E501
     Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.008, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "cream", "dark brown")),  # noqa: E501
+    Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.008, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "black", "black", "charcoal")),  # noqa: E501
+    Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.008, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", "white", "grey")),  # noqa: E501
+    Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.008, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "black", "tan", "dark brown")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501

@@ -52,19 +52,21 @@ class Foot:
         return (self.heel_y - p[..., 1]) / (self.heel_y - self.toe_y)
 
 
-def _shoe_faces(body: AuthoringBody, foot: Foot, faces: np.ndarray) -> np.ndarray:
+def _shoe_faces(body: AuthoringBody, foot: Foot, faces: np.ndarray,
+                top: float = 0.96) -> np.ndarray:  # fmt: skip
     """(F,) bool: helper-tights faces of one foot and its ankle, the bottom left open for
     the sole (faces within 1.5 cm of the ground and facing down or out low)."""
     ff = regions.face_features(body.vertices, faces, body.part, body.marks)
     side = np.sign(ff.centre[:, 0]) == (1 if foot.side == 0 else -1)
-    shoe = (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > 0.96))
+    shoe = (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > top))
     low = ff.centre[:, 2] < foot.ground + 0.012
     return shoe & side & ~low
 
 
-def upper(body: AuthoringBody, foot: Foot) -> Piece:
+def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
+    """The upper up to ``top`` along the leg (0.96: below the ankle; 0.85: an ankle boot)."""
     faces = body.group_faces("helper-tights")
-    mesh = cut(body, faces, _shoe_faces(body, foot, faces), EASE, relax=10)
+    mesh = cut(body, faces, _shoe_faces(body, foot, faces, top), EASE, relax=10)
     mesh = _toe_box(body, foot, mesh, EASE)
     return bound(body, _planar_uvs(mesh, "upper"), faces)
 
@@ -197,13 +199,15 @@ def laces(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     return bound(body, _planar_uvs(mesh, "laces"), body.group_faces("helper-tights"))
 
 
-def shoes(body: AuthoringBody) -> Piece:
-    """Both shoes, every piece bound to the body's ``helper-tights`` shell."""
+def shoes(body: AuthoringBody, top: float = 0.96) -> Piece:
+    """Both shoes, every piece bound to the body's ``helper-tights`` shell; ``top``: how
+    far up the leg the upper reaches (``upper``)."""
     pieces = []
     for side in (0, 1):
         foot = Foot(body, side)
-        top = upper(body, foot)
-        pieces += [top, toe_cap(body, foot), sole(body, foot, top), laces(body, foot, top)]
+        top_piece = upper(body, foot, top)
+        pieces += [top_piece, toe_cap(body, foot), sole(body, foot, top_piece),
+                   laces(body, foot, top_piece)]
     return join(pieces)
 
 
