@@ -18,14 +18,15 @@ import numpy as np
 
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-blender-"))
 
-BODIES = [
-    ({"gender": 0.0, "age": 0.5, "weight": 0.5}, ("eyebrows-blond", "eyelashes", "hair-long", "tshirt", "jeans", "shoes")),  # noqa: E501
-    ({"gender": 1.0, "age": 0.6, "weight": 0.9, "muscle": 0.3}, ("eyebrows", "eyelashes", "hair-short", "longsleeve", "trousers", "socks", "shoes")),  # noqa: E501
-    ({"gender": 0.0, "age": 0.3, "weight": 0.2}, ("eyebrows-black", "eyelashes", "hair-ponytail", "dress", "shoes")),  # noqa: E501
-    ({"gender": 1.0, "age": 0.9, "weight": 0.6}, ("eyebrows", "eyelashes", "cap", "jacket", "tshirt", "shorts", "socks", "shoes")),  # noqa: E501
-    ({"gender": 0.0, "age": 0.45, "weight": 0.7}, ("eyebrows", "eyelashes", "hair-short", "tanktop", "skirt", "shoes")),  # noqa: E501
-    ({"gender": 1.0, "age": 0.25, "muscle": 1.0}, ("eyebrows", "eyelashes", "hair-short", "hoodie", "leggings", "shoes")),  # noqa: E501
-    ({"gender": 0.0, "age": 0.5, "weight": 0.4}, ("eyebrows-blond", "eyelashes", "hair-long", "swimsuit")),  # noqa: E501
+BODIES = [  # child, teen, woman, man, heavy, muscular, elderly woman and man: all 30 items
+    ({"gender": 0.5, "age": 0.12}, ("eyebrows", "eyelashes", "hair-bob", "tshirt", "sweatpants", "sneakers")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.3, "weight": 0.35}, ("eyebrows-black", "eyelashes", "hair-ponytail", "swimsuit")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.5, "weight": 0.5}, ("eyebrows-blond", "eyelashes", "hair-long", "dress", "shoes-black")),  # noqa: E501
+    ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short", "longsleeve", "jacket", "jeans", "boots")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.6, "weight": 1.0}, ("eyebrows", "eyelashes", "hair-short", "tanktop", "skirt", "socks", "shoes")),  # noqa: E501
+    ({"gender": 1.0, "age": 0.3, "muscle": 1.0}, ("eyebrows-black", "eyelashes", "hair-buzz", "hoodie", "shorts", "sneakers")),  # noqa: E501
+    ({"gender": 0.0, "age": 0.95, "weight": 0.6}, ("eyebrows", "eyelashes", "hair-bun", "tshirt", "cardigan", "leggings", "shoes-black")),  # noqa: E501
+    ({"gender": 1.0, "age": 1.0, "weight": 0.6}, ("eyebrows", "eyelashes", "cap", "tshirt", "trousers", "socks", "shoes")),  # noqa: E501
 ]  # fmt: skip
 
 
@@ -75,6 +76,8 @@ def main() -> None:
     parser.add_argument("--out", default="docs/images")
     parser.add_argument("--texture", type=int, default=512)
     parser.add_argument("--walk", action="store_true", help="mid-stride in the built-in walk")
+    parser.add_argument("--name", default="clothes", help="file stem: NAME[_walk]_front.png")
+    parser.add_argument("--views", default="front,back")
     args = parser.parse_args()
     from avatar.blender import render, scene
     from avatar.clothes.library import dress, load_garment
@@ -89,9 +92,11 @@ def main() -> None:
             shown = Posed(human, outfit, _mid_stride(human))
         chars.append(scene.Character(f"dressed{i}", shown.parts(), shown.skeleton))
     out = Path(args.out)
-    stem = "clothes_walk" if args.walk else "clothes"
-    for view, direction in (("front", (0.25, -1.0, 0.12)), ("back", (-0.25, 1.0, 0.12))):
-        size = (300 * len(chars), 620)
+    stem = f"{args.name}_walk" if args.walk else args.name
+    directions = {"front": (0.25, -1.0, 0.12), "back": (-0.25, 1.0, 0.12)}
+    for view in args.views.split(","):
+        direction = directions[view]
+        size = (280 * len(chars), 620)
         render.stage_characters(chars, size, spacing=0.7, direction=direction)
         render.render(out / f"{stem}_{view}.png", samples=args.samples, resolution=size)
         print(out / f"{stem}_{view}.png")

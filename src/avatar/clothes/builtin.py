@@ -86,7 +86,7 @@ def opened(keep_fn, gap: float = 0.012):
     body's midline on the front (a jacket or cardigan worn open)."""
 
     def keep(ff, m):
-        front = ff.centre[:, 1] < m.neck[1] - 0.02
+        front = ff.centre[:, 1] < m.neck[1] + 0.01  # the neck's front too: open to the collar
         return keep_fn(ff, m) & ~(front & (np.abs(ff.centre[:, 0]) < gap))
 
     return keep
@@ -214,7 +214,7 @@ SPECS = [
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
     Spec("jacket", "tops", lambda b: _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
-    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.01), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
+    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
