@@ -21,7 +21,7 @@ def walker():
     try:
         human = Human({"weight": 0.6}).dressed(*GARMENTS)
         walk = human.walk(seconds=FRAMES / 30, fps=30)
-        parts = {p.name: len(p.mesh.vertices) for p in human.parts()}
+        parts = {p.name: (len(p.mesh.vertices), p.material) for p in human.parts()}
     except AssetError as exc:
         pytest.skip(f"MakeHuman assets not installed: {exc}")
     return human, walk, parts
@@ -101,10 +101,16 @@ def test_reimport_keeps_meshes_bones_animation_and_textures(empty_scene, walker,
         names = {re.sub(r"[^A-Za-z0-9_]", "_", n) for n in names}
     assert names <= bones, sorted(names - bones)[:5]
     assert _frames(armatures[0]) == walk.frames
-    for name, count in parts.items():
+    for name, (count, material) in parts.items():
         obj = _mesh(name)
         if suffix != ".glb":  # glTF splits vertices on UV seams; its own test checks counts
             assert len(obj.data.vertices) == count, (name, len(obj.data.vertices), count)
+        if material.base_color_texture is None:  # a plain colour (teeth, tongue) stays one
+            bsdf = next(n for n in obj.active_material.node_tree.nodes
+                        if n.type == "BSDF_PRINCIPLED")  # fmt: skip
+            got = bsdf.inputs["Base Color"].default_value[:3]
+            assert got == pytest.approx(material.base_color[:3], abs=0.02), name
+            continue
         image, bsdf = _base_colour_image(obj, through_mix=suffix == ".glb")
         assert image.size[0] > 0 and image.size[1] > 0, name
         if name == "body":
