@@ -18,8 +18,23 @@ CASES = list(itertools.product(
 ))  # fmt: skip
 
 
+@pytest.fixture
+def render_settings():
+    """Put back the render size, percentage and pixel aspect the test changes (later tests
+    of the same process frame their cameras with them)."""
+    import bpy
+
+    r = bpy.context.scene.render
+    saved = (r.resolution_x, r.resolution_y, r.resolution_percentage, r.pixel_aspect_x,
+             r.pixel_aspect_y)  # fmt: skip
+    yield
+    (r.resolution_x, r.resolution_y, r.resolution_percentage, r.pixel_aspect_x,
+     r.pixel_aspect_y) = saved  # fmt: skip
+
+
 @pytest.mark.parametrize(("fit", "resolution", "shift", "aspect", "percentage"), CASES)
-def test_projection_matches_blender(empty_scene, rng, fit, resolution, shift, aspect, percentage):
+def test_projection_matches_blender(empty_scene, render_settings, rng, fit, resolution, shift,
+                                    aspect, percentage):  # fmt: skip
     import bpy
     from bpy_extras.object_utils import world_to_camera_view
     from mathutils import Vector
