@@ -41,7 +41,7 @@ GOALS = {"dressed create": 0.2, "bare change": 0.005, "dressed change": 0.017}
 def main() -> None:
     args = _parse()
     os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="avatar-bench-")
-    import bpy  # noqa: TID251 - this benchmark times Blender itself
+    import bpy
 
     zip_path = _build_zip()
     assert bpy.ops.extensions.package_install_files(
