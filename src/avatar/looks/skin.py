@@ -288,7 +288,7 @@ def _base_skin(tone: np.ndarray, size: int, rng: np.random.Generator, age: float
     spot_hue = np.array([1.0, 0.96, 0.88], np.float32)  # age spots are brown, not grey
     colour = tone[None, None, :] * light[..., None] * hue
     colour *= 1 + (spot_hue - 1) * np.clip(spots * 4, 0, 1)[..., None]
-    rough = 0.5 + 0.1 * old + 0.06 * pores + 0.02 * mottle
+    rough = 0.56 + 0.1 * old + 0.06 * pores + 0.02 * mottle  # skin, not oil: little gloss
     return colour.astype(np.float32), rough.astype(np.float32)
 
 
@@ -322,8 +322,8 @@ def _paint_regions(colour, rough, tone, masks: dict[str, np.ndarray]) -> None:
         else:  # nails: pale, taking a little of the skin's colour through them
             target = 0.75 * nail + 0.25 * tone
         colour[box] = c + (target - c) * m
-        # Relative to plain skin (0.55), so age's drier skin shows in every region.
-        rough[box] += (np.float32(region_rough) - np.float32(0.55)) * m[..., 0]
+        # Relative to plain skin (0.56), so age's drier skin shows in every region.
+        rough[box] += (np.float32(region_rough) - np.float32(0.56)) * m[..., 0]
 
 
 def _bounding_box(mask: np.ndarray) -> tuple[slice, slice]:
