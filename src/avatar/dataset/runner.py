@@ -136,6 +136,12 @@ def _render_one(config: Config, index: int, out: str) -> Result:
     """Worker side: render one sample; errors come back as text (never kill the pool)."""
     # Blender writes its user config at import: a private folder, not the user's
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
+    if "bpy" not in sys.modules:
+        # A spawned worker inherits its parent's sys.path: where the parent had imported bpy,
+        # that holds Blender's own scripts folders, whose pure-Python ``bpy`` would shadow
+        # the module's (and fail on ``_bpy``). Blender adds them back when it starts.
+        marker = f"{os.sep}bpy{os.sep}"
+        sys.path[:] = [p for p in sys.path if not (marker in p and "scripts" in p)]
     from avatar.dataset.worker import render_sample
 
     try:
