@@ -52,7 +52,7 @@ def labels(out: Path, count: int) -> dict[str, bytes]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--kills", type=int, default=20)
-    parser.add_argument("--count", type=int, default=6)
+    parser.add_argument("--count", type=int, default=16)
     parser.add_argument("--seed", type=int, default=0, help="of the kill moments")
     args = parser.parse_args()
     rng = random.Random(args.seed)
@@ -66,7 +66,7 @@ def main() -> int:
         out = Path(tmp) / "killed"
         kills = 0
         while kills < args.kills:
-            code = run(config, out, args.count, kill_after=rng.uniform(0.5, per_run))
+            code = run(config, out, args.count, kill_after=rng.uniform(1.0, 12.0))
             if code != -9:
                 break  # it finished before the kill
             kills += 1
