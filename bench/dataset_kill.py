@@ -70,7 +70,8 @@ def main() -> int:
             if code != -9:
                 break  # it finished before the kill
             kills += 1
-            done = (out / "manifest.jsonl").read_text().count("\n") if out.exists() else 0
+            manifest = out / "manifest.jsonl"
+            done = manifest.read_text().count("\n") if manifest.exists() else 0
             print(f"kill {kills}: {done} samples finished so far")
         assert run(config, out, args.count) == 0
         lines = [json.loads(x) for x in (out / "manifest.jsonl").read_text().splitlines()]
