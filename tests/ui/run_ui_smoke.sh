@@ -32,7 +32,7 @@ BODY_HEADER_DY="${AVATAR_UI_BODY_HEADER_DY:-15}"   # click: fold the Body panel
 GENDER_DY="${AVATAR_UI_GENDER_DY:-131}"    # the Gender slider (blue while Body is open)
 LIBRARY_DX="${AVATAR_UI_LIBRARY_DX:-102}"  # Dress > Load Library, with Body folded
 LIBRARY_DY="${AVATAR_UI_LIBRARY_DY:-73}"
-GARMENT1_DX="${AVATAR_UI_GARMENT1_DX:-59}"  # the grid's tshirt and jeans buttons
+GARMENT1_DX="${AVATAR_UI_GARMENT1_DX:-59}"  # the grid's tshirt and trousers buttons
 GARMENT1_DY="${AVATAR_UI_GARMENT1_DY:-162}"
 GARMENT2_DX="${AVATAR_UI_GARMENT2_DX:-146}"
 GARMENT2_DY="${AVATAR_UI_GARMENT2_DY:-420}"
@@ -168,7 +168,7 @@ wear() {  # wear DX DY NAME: click a grid cell, poll until the garment is on (a 
   echo "$3 was not worn" >&2
 }
 wear "$GARMENT1_DX" "$GARMENT1_DY" tshirt
-wear "$GARMENT2_DX" "$GARMENT2_DY" jeans
+wear "$GARMENT2_DX" "$GARMENT2_DY" trousers
 request bvh
 click $((LEFT + 60)) $((TOP + DRESS_HEADER_DY))     # fold the Dress panel
 sleep 0.5

@@ -71,7 +71,7 @@ def _check_session(folder):
     assert undone["shown"]["body"] == created["shown"]["body"]
     # Two clicks in the Dress panel's grid: both garments worn, as objects.
     worn, recipe = state("after-wear")
-    assert {"tshirt", "jeans"} <= set(recipe["clothes"]) and {"tshirt", "jeans"} <= set(
+    assert {"tshirt", "trousers"} <= set(recipe["clothes"]) and {"tshirt", "trousers"} <= set(
         worn["shown"]
     )
     # Apply (Motion) on the dressed character: 30 frames played, the report kept.
