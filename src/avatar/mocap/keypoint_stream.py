@@ -18,14 +18,11 @@ from __future__ import annotations
 
 import json
 import math
-import socket
-import time
 
 import numpy as np
 
-from avatar.errors import ParameterError
 from avatar.mocap.keypoints import AXES, KeypointSet
-from avatar.mocap.stream import Frame, Source
+from avatar.mocap.stream import Frame, UdpSource
 
 DEFAULT_PORT = 39540
 
@@ -112,34 +109,12 @@ class KeypointParser:
         return seq, (None if t is None else float(t)), (points, confidence, axes)
 
 
-class KeypointReceiver(Source):
+class KeypointReceiver(UdpSource):
     """Listens for the keypoints stream of one set on UDP ``host:port`` (0: any port)."""
 
     def __init__(self, keypoints: KeypointSet, host: str = "0.0.0.0", port: int = DEFAULT_PORT):
-        super().__init__()
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        # room for a second of frames while the thread waits for the interpreter
-        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
-        try:
-            self.sock.bind((host, port))
-        except OSError as exc:
-            self.sock.close()
-            raise ParameterError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
-        self.sock.settimeout(0.05)
-        self.address = self.sock.getsockname()
+        super().__init__(host, port)
         self.parser = KeypointParser(keypoints, self.counters)
 
-    def _loop(self) -> None:
-        while not self._stop.is_set():
-            try:
-                data = self.sock.recv(65535)
-            except TimeoutError:
-                continue
-            except OSError:
-                if self._stop.is_set():
-                    return
-                raise
-            self.parser.feed(data, time.perf_counter())
-
-    def _close(self) -> None:
-        self.sock.close()
+    def feed(self, data: bytes, arrival: float) -> None:
+        self.parser.feed(data, arrival)

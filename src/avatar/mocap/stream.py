@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import collections
 import logging
+import socket
 import threading
 import time
 from dataclasses import dataclass
 from typing import Any
+
+from avatar.errors import ParameterError
 
 log = logging.getLogger(__name__)
 
@@ -161,3 +164,39 @@ class Source:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+class UdpSource(Source):
+    """A Source listening on UDP ``host:port`` (port 0: any free port, see ``address``);
+    every datagram goes to ``feed(data, arrival_time)``, which subclasses provide."""
+
+    def __init__(self, host: str, port: int):
+        super().__init__()
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        # room for a second of frames while the thread waits for the interpreter
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
+        try:
+            self.sock.bind((host, port))
+        except OSError as exc:
+            self.sock.close()
+            raise ParameterError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
+        self.sock.settimeout(0.05)
+        self.address = self.sock.getsockname()
+
+    def feed(self, data: bytes, arrival: float) -> None:
+        raise NotImplementedError
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data = self.sock.recv(65535)
+            except TimeoutError:
+                continue
+            except OSError:
+                if self._stop.is_set():
+                    return
+                raise
+            self.feed(data, time.perf_counter())
+
+    def _close(self) -> None:
+        self.sock.close()

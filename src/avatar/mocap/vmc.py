@@ -27,7 +27,6 @@ from __future__ import annotations
 import logging
 import math
 import socket
-import time
 from collections.abc import Iterable
 
 import numpy as np
@@ -36,7 +35,7 @@ from pythonosc.osc_message_builder import OscMessageBuilder
 from pythonosc.osc_packet import OscPacket
 
 from avatar.errors import ParameterError
-from avatar.mocap.stream import Frame, Source
+from avatar.mocap.stream import Frame, UdpSource
 from avatar.mocap.unity import UnityPose, human_bones
 
 log = logging.getLogger(__name__)
@@ -177,7 +176,7 @@ class VmcAssembler:
         return [frame]
 
 
-class VmcReceiver(Source):
+class VmcReceiver(UdpSource):
     """Listens for VMC on UDP ``host:port`` (port 0: any free port, see ``address``).
 
     ``poll()``/``take()`` give ``Frame``s whose ``data`` is a ``unity.UnityPose``; drive a
@@ -185,33 +184,11 @@ class VmcReceiver(Source):
     """
 
     def __init__(self, host: str = "0.0.0.0", port: int = DEFAULT_PORT):
-        super().__init__()
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        # room for a second of frames while the thread waits for the interpreter
-        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
-        try:
-            self.sock.bind((host, port))
-        except OSError as exc:
-            self.sock.close()
-            raise ParameterError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
-        self.sock.settimeout(0.05)
-        self.address = self.sock.getsockname()
+        super().__init__(host, port)
         self.assembler = VmcAssembler(self.counters)
 
-    def _loop(self) -> None:
-        while not self._stop.is_set():
-            try:
-                data = self.sock.recv(65535)
-            except TimeoutError:
-                continue
-            except OSError:
-                if self._stop.is_set():
-                    return
-                raise
-            self.assembler.feed(data, time.perf_counter())
-
-    def _close(self) -> None:
-        self.sock.close()
+    def feed(self, data: bytes, arrival: float) -> None:
+        self.assembler.feed(data, arrival)
 
 
 class VmcSender:
