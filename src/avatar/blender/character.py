@@ -251,13 +251,7 @@ def authoring_root(
     return min(roots, key=lambda r: (r.matrix_world.translation - centre).length)
 
 
-def root_of(obj: bpy.types.Object | None) -> bpy.types.Object | None:
-    """The object holding the recipe: ``obj`` or its nearest ancestor that has one."""
-    while obj is not None:
-        if RECIPE_KEY in obj.keys():
-            return obj
-        obj = obj.parent
-    return None
+root_of = live.root_of  # the object holding the recipe: obj or its nearest such ancestor
 
 
 def recipe_of(obj: bpy.types.Object | None) -> dict | None:
