@@ -39,6 +39,10 @@ import bpy  # noqa: E402
 
 from . import operators, panels, properties, thumbnails  # noqa: E402
 
+# Feature modules: each has CLASSES (registered in order, after the core's) and may have
+# POINTERS, {(bpy type, attribute): PropertyGroup}, attached after its classes register.
+FEATURES: tuple = ()
+
 CLASSES = (
     properties.AvatarModifier,
     properties.AvatarCharacter,
@@ -47,19 +51,32 @@ CLASSES = (
     properties.AvatarPreferences,
     *operators.CLASSES,
     *panels.CLASSES,
+    *(cls for feature in FEATURES for cls in feature.CLASSES),
 )
+
+
+def _pointers() -> dict:
+    pointers = {
+        (bpy.types.Scene, "avatar"): properties.AvatarSettings,
+        (bpy.types.Object, "avatar"): properties.AvatarCharacter,
+    }
+    for feature in FEATURES:
+        pointers.update(getattr(feature, "POINTERS", {}))
+    return pointers
 
 
 def register() -> None:
     for cls in CLASSES:
         bpy.utils.register_class(cls)
-    bpy.types.Scene.avatar = bpy.props.PointerProperty(type=properties.AvatarSettings)
-    bpy.types.Object.avatar = bpy.props.PointerProperty(type=properties.AvatarCharacter)
+    for (owner, name), group in _pointers().items():
+        setattr(owner, name, bpy.props.PointerProperty(type=group))
 
 
 def unregister() -> None:
     thumbnails.release()
-    del bpy.types.Object.avatar
-    del bpy.types.Scene.avatar
+    for feature in FEATURES:
+        getattr(feature, "release", lambda: None)()  # timers, sockets, preview collections
+    for owner, name in _pointers():
+        delattr(owner, name)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)
