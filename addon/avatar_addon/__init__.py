@@ -12,7 +12,9 @@ changes it live; ``bpy.ops.avatar.wear(name="tshirt")`` dresses the active chara
 
 from __future__ import annotations
 
+import importlib
 import os
+import pkgutil
 import sys
 
 bl_info = {  # legacy add-ons only; Blender 4.2+ reads blender_manifest.toml
@@ -39,9 +41,16 @@ import bpy  # noqa: E402
 
 from . import operators, panels, properties, thumbnails  # noqa: E402
 
-# Feature modules: each has CLASSES (registered in order, after the core's) and may have
-# POINTERS, {(bpy type, attribute): PropertyGroup}, attached after its classes register.
-FEATURES: tuple = ()
+# Feature modules, ``panel_<name>.py`` (one sidebar panel with its operators and settings
+# each, so features grow without touching the core files): each has CLASSES (registered in
+# order, after the core's) and may have POINTERS, {(bpy type, attribute): PropertyGroup},
+# attached after its classes register, and release() run first on unregister. Panels place
+# themselves in the sidebar with bl_order.
+FEATURES: tuple = tuple(
+    importlib.import_module(f"{__name__}.{module.name}")
+    for module in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name)
+    if module.name.startswith("panel_")
+)
 
 CLASSES = (
     properties.AvatarModifier,

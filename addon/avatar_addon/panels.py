@@ -22,6 +22,7 @@ class _AvatarPanel:
 class AVATAR_PT_body(_AvatarPanel, bpy.types.Panel):
     bl_label = "Body"
     bl_idname = "AVATAR_PT_body"
+    bl_order = 0  # feature panels (panel_*.py) follow: 3 and up
 
     def draw(self, context):
         settings = context.scene.avatar
@@ -133,6 +134,7 @@ def _draw_body_tools(layout, settings):
 class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
     bl_label = "Dress"
     bl_idname = "AVATAR_PT_dress"
+    bl_order = 1  # feature panels (panel_*.py) follow: 3 and up
 
     def draw(self, context):
         settings = context.scene.avatar
@@ -168,6 +170,7 @@ class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
 class AVATAR_PT_motion(_AvatarPanel, bpy.types.Panel):
     bl_label = "Motion"
     bl_idname = "AVATAR_PT_motion"
+    bl_order = 2  # feature panels (panel_*.py) follow: 3 and up
 
     def draw(self, context):
         settings = context.scene.avatar
