@@ -99,11 +99,68 @@ def _new_material(record, fallback_name: str) -> bpy.types.Material:
     _link_colour(mat, bsdf, record)
     _link_roughness(mat.node_tree, bsdf, record)
     _link_normal(mat.node_tree, bsdf, record)
+    if is_hair(record):
+        hair_shading(mat.node_tree, bsdf, record)
     if record.alpha_mode == "BLEND" and hasattr(mat, "surface_render_method"):
         mat.surface_render_method = "BLENDED"  # EEVEE; Cycles blends regardless
     if record.alpha_mode != "OPAQUE":
         allow_transparent_layers(bpy.context.scene)
     return mat
+
+
+# Hair: strands run along the texture's v axis on every Avatar hair surface (cards from root
+# v = 0.5 to tip v = 0, scalp caps bottom to top, lashes lid to tip; ``looks.textures``).
+HAIR_ANISOTROPY = 0.8  # how stretched the highlight is across the strands (0..1)
+HAIR_SHEEN = 0.25  # the soft fibre rim seen at grazing angles
+UV_MAP = "UVMap"  # the layer ``blender.mesh`` makes
+
+
+def is_hair(record) -> bool:
+    """Whether a Material record is hair (scalp hair, lashes; an ``anisotropy`` hint or
+    Avatar's ``hair`` fabric), so it gets the anisotropic fibre shading. Eyebrows are not:
+    their hairs run every way across the texture."""
+    if "anisotropy" in record.extras:
+        return float(record.extras["anisotropy"]) > 0
+    return record.extras.get("fabric") == "hair" and not record.name.startswith("eyebrows")
+
+
+def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
+    """Anisotropic fibre shading on a hair material's Principled BSDF (for meshes: the
+    Principled Hair BSDF shades curves only).
+
+    The highlight is stretched across the strands: the tangent comes from the UV map (its
+    u direction) rotated a quarter turn (``Anisotropic Rotation`` 0.25) onto v, along which
+    the strands run. The specular is tinted by the hair's own colour (the coloured second
+    highlight of real hair) and fades towards the roots of the cards (v = 0.5, in the shade
+    of the hair above them); a little sheen gives the soft rim of fibres. Base colour and
+    alpha stay wired straight from the texture (exporters follow that link).
+    """
+    amount = float(record.extras.get("anisotropy", HAIR_ANISOTROPY))
+    bsdf.inputs["Anisotropic"].default_value = amount
+    bsdf.inputs["Anisotropic Rotation"].default_value = 0.25
+    tangent = tree.nodes.new("ShaderNodeTangent")
+    tangent.direction_type, tangent.uv_map, tangent.location = "UV_MAP", UV_MAP, (-300, -550)
+    tree.links.new(tangent.outputs["Tangent"], bsdf.inputs["Tangent"])
+    if "Sheen Weight" in bsdf.inputs and "sheen" not in record.extras:
+        bsdf.inputs["Sheen Weight"].default_value = HAIR_SHEEN
+        bsdf.inputs["Sheen Roughness"].default_value = 0.4
+    colour = bsdf.inputs["Base Color"].links
+    if colour and "Specular Tint" in bsdf.inputs:
+        tree.links.new(colour[0].from_socket, bsdf.inputs["Specular Tint"])
+    # Roots darker in the highlight: v in [0, 0.5] runs tip to root on the cards; the
+    # scalp caps (v > 0.5) are all root.
+    uv = tree.nodes.new("ShaderNodeUVMap")
+    uv.uv_map, uv.location = UV_MAP, (-700, -700)
+    split = tree.nodes.new("ShaderNodeSeparateXYZ")
+    split.location = (-500, -700)
+    tree.links.new(uv.outputs["UV"], split.inputs["Vector"])
+    fade = tree.nodes.new("ShaderNodeMapRange")
+    fade.location = (-300, -750)
+    tree.links.new(split.outputs["Y"], fade.inputs["Value"])
+    level = float(bsdf.inputs["Specular IOR Level"].default_value)
+    fade.inputs["From Min"].default_value, fade.inputs["From Max"].default_value = 0.0, 0.5
+    fade.inputs["To Min"].default_value, fade.inputs["To Max"].default_value = level, 0.4 * level
+    tree.links.new(fade.outputs["Result"], bsdf.inputs["Specular IOR Level"])
 
 
 def allow_transparent_layers(scene: bpy.types.Scene, layers: int = 64) -> None:
