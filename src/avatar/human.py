@@ -25,7 +25,7 @@ from avatar.body import shaped
 from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
-from avatar.clothes import library
+from avatar.clothes import footing, library
 from avatar.clothes.asset import material_from_file
 from avatar.clothes.outfit import Outfit
 from avatar.errors import ParameterError, unknown_name
@@ -238,8 +238,22 @@ class Human:
     # ------------------------------------------------------------------ geometry
     @cached_property
     def vertices(self) -> np.ndarray:
-        """(19158, 3) float32 all vertices incl. helpers, metres, Z-up, feet on z = 0."""
-        return shaped.rest_vertices(self.model, self.recipe.params)
+        """(19158, 3) float32 all vertices incl. helpers, metres, Z-up, feet on z = 0 (or,
+        wearing built-in shoes, raised by ``sole_height`` so their soles are on it)."""
+        rest = shaped.rest_vertices(self.model, self.recipe.params)
+        rest[:, 2] += np.float32(self._sole_height(rest))
+        return rest
+
+    @property
+    def sole_height(self) -> float:
+        """Metres the body stands up on its built-in shoes' soles (0 barefoot)."""
+        return self._sole_height(shaped.rest_vertices(self.model, self.recipe.params))
+
+    def _sole_height(self, rest: np.ndarray) -> float:
+        if "sole_height" not in self.__dict__:
+            self.__dict__["sole_height"] = footing.sole_height(
+                rest, self.recipe.clothes, self.recipe.folders, self.model)
+        return self.__dict__["sole_height"]
 
     @cached_property
     def body(self) -> Body:
@@ -290,7 +304,15 @@ class Human:
             return shaped.rig_definition(self.model, "default").skeleton(self.vertices)
 
         pose = poselib.load(name, self.skeleton, folders, reference)
-        return pose if name.lower() == "rest" else floor.settle_body(self.body, pose)[0]
+        if name.lower() == "rest":
+            return pose
+        return self._on_soles(floor.settle_body(self.body, pose)[0])
+
+    def _on_soles(self, animation: Animation) -> Animation:
+        """A motion settled on the skin (feet on z = 0) raised onto the shoes' soles."""
+        if not self.sole_height:
+            return animation
+        return floor.raise_by(self.skeleton, animation, self.sole_height)
 
     def walk(self, seconds: float = 2.0, fps: float = 30.0, cadence: float = 1.0) -> Animation:
         """The built-in walk on this human's rig, arms hung clear of its own torso
@@ -302,7 +324,8 @@ class Human:
     ) -> tuple[Animation, RetargetReport]:
         """A clip on ``source`` retargeted onto this human and settled on its skin (planted
         feet on the floor); options as ``avatar.motion.retarget``."""
-        return retarget(source, animation, self.skeleton, body=self.body, **options)
+        moved, report = retarget(source, animation, self.skeleton, body=self.body, **options)
+        return self._on_soles(moved), report
 
     def posed(
         self, animation: Animation, frames: slice | None = None, method: str = "lbs"
