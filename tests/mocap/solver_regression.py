@@ -59,11 +59,14 @@ def settings_of(spec: dict):
 
 
 def skeleton_of(data, rig: str):
-    """The stored skeleton of ``rig`` (float32 on disk, float64 here)."""
+    """The stored skeleton of ``rig`` (float32 on disk; float64 here, the rest rotations made
+    orthonormal again, as every real rig's are, to 1e-16)."""
     from avatar.rig.skeleton import Skeleton
 
     rest = np.zeros((len(data[f"{rig}__parents"]), 4, 4))
     rest[:, :3, :] = data[f"{rig}__rest"]
+    u, _, vt = np.linalg.svd(rest[:, :3, :3])
+    rest[:, :3, :3] = u @ vt
     rest[:, 3, 3] = 1.0
     return Skeleton(tuple(str(n) for n in data[f"{rig}__names"]),
                     data[f"{rig}__parents"].astype(np.int32), rest,
