@@ -1,25 +1,38 @@
-"""The Blender extension's speed in pip bpy: create, dressed create, slider changes.
+"""The Blender extension's speed in pip bpy, beside MPFB2 in the same process when given one.
 
     .venv/bin/python bench/blender.py [--repeat 15] [--garments tshirt,jeans,shoes]
+    .venv/bin/python bench/blender.py --mpfb PATH [--assets FOLDER] [--repeat 15]
 
 Installs the extension zip (built here, ``--no-wheel``) into a private user folder and
 drives it as a script or slider does:
 
-- create a bare human (no rig, no clothes) and a dressed, rigged one (hair, brows, lashes
-  and ``--garments``) with ``bpy.ops.avatar.create_human`` + ``wear``-equivalent recipes;
+- create a bare human (no rig, no clothes) and a dressed, rigged one with
+  ``avatar.blender.character.create`` (what the Create button calls; real-time garment fit);
 - one slider change (``obj.avatar.weight = v``) on each: mesh, rest bones and garments
-  written in place (real-time garment fit), timed until the property assignment returns;
+  written in place, timed until the property assignment returns;
 - the settle that follows a change (exact garments, skin texture, measurements).
 
 Anchor, measured in the same run: the pre-live extension's path for a change, a whole
 rebuild of the character (``export.character`` + ``scene.build_character``, what the
-**Update** button did). The issue's MPFB2 2.0.17 figures (same kind of machine, same
-process) are printed beside: 0.29 s create, 1.71 s dressed create, 42 ms bare change,
-0.28 s dressed change. ``--mpfb`` is not driven yet (no MPFB2 checkout on these machines).
+**Update** button did).
 
-Medians over ``--repeat`` runs, after one warm-up (which builds the garments, skin texture
-and template meshes once per session). Threads: numpy/BLAS and pykdtree may use all cores;
-on shared machines set OMP_NUM_THREADS=1 (the README's figures say which).
+``--mpfb PATH`` (an MPFB2 checkout, its ``src/`` or its ``src/mpfb`` package; see
+``bench/mpfb_checkout.py`` for a partial clone) registers MPFB2 as a user extension in the
+same process (its ``register()``) and times the same four steps through its own operators
+(``bench/mpfb_driver.py`` says which), alternating the two add-ons repeat by repeat (the
+order swapped every repeat) so that the load of a shared machine falls on both alike. The
+dressed, rigged human is then the *same* MakeHuman assets on both sides: short02 hair,
+eyebrow001, eyelashes01, male_casualsuit06 (T-shirt + jeans) and shoes01, from ``--assets``
+(default ``../shared/fixtures/makehuman``, CC0), on MakeHuman's 163-bone default rig; MPFB2
+finds them through its "second root" asset folder preference. Its dressed slider change is
+the macro slider plus ``HumanService.refit`` (what "Auto refit assets" runs), both timed.
+Without ``--mpfb`` the MPFB2 column is the issue's MPFB2 2.0.17 figures (same kind of
+machine): 0.29 s create, 1.71 s dressed create, 42 ms bare change, 0.28 s dressed change.
+
+Goals (issue 13): a dressed, rigged human < 0.2 s and >= 5x MPFB2; a dressed slider change
+< 17 ms and >= 10x; a bare one < 5 ms and >= 8x. Medians over ``--repeat`` runs after one
+warm-up. Threads: numpy/BLAS and pykdtree may use all cores; on shared machines set
+OMP_NUM_THREADS=1 (the report prints the setting and the load average).
 """
 
 from __future__ import annotations
@@ -31,128 +44,271 @@ import statistics
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-MPFB2 = {"create": 0.29, "dressed create": 1.71, "bare change": 0.042, "dressed change": 0.28}
-GOALS = {"dressed create": 0.2, "bare change": 0.005, "dressed change": 0.017}
+FIXTURES = ROOT.parent / "shared" / "fixtures" / "makehuman"
+ISSUE_MPFB2 = {"create": 0.29, "dressed create": 1.71, "bare change": 0.042,
+               "dressed change": 0.28}  # fmt: skip
+# step -> (seconds Avatar must stay under, how many times faster than MPFB2 it must be)
+GOALS = {"dressed create": (0.2, 5.0), "dressed change": (0.017, 10.0),
+         "bare change": (0.005, 8.0)}  # fmt: skip
+LABELS = {
+    "create": "create a human",
+    "dressed create": "dressed, rigged human",
+    "bare change": "slider change, bare",
+    "dressed change": "slider change, dressed+rigged, refit",
+}
+# The dressed human when MPFB2 is driven: MakeHuman system assets both add-ons can wear.
+MAKEHUMAN_LOOK = (
+    "hair/short02/short02.mhclo",
+    "eyebrows/eyebrow001/eyebrow001.mhclo",
+    "eyelashes/eyelashes01/eyelashes01.mhclo",
+    "clothes/male_casualsuit06/male_casualsuit06.mhclo",
+    "clothes/shoes01/shoes01.mhclo",
+)
+MACRO = "weight"  # the slider both add-ons move
+
+Step = Callable[[int], float]  # repeat index -> seconds
 
 
-def main() -> None:
-    args = _parse()
+def main(argv: list[str] | None = None) -> None:
+    args = _parse(argv)
+    assets = _assets(args)
     os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="avatar-bench-")
     import bpy
 
+    load_before = os.getloadavg()
     zip_path = _build_zip()
     assert bpy.ops.extensions.package_install_files(
         filepath=str(zip_path), repo="user_default", enable_on_install=True
     ) == {"FINISHED"}
-    from avatar.blender import character, scene
+    mpfb = _register_mpfb(args, assets)
+    from avatar.blender import scene
 
-    dressed = ["hair-short", "eyebrows", "eyelashes", *args.garments.split(",")]
+    dressed = ([str(p) for p in assets] if assets
+               else ["hair-short", "eyebrows", "eyelashes", *args.garments.split(",")])  # fmt: skip
     scene.clear_scene()
-    results = {
-        "create": _time_create(bpy, [], False, args.repeat),
-        "dressed create": _time_create(bpy, dressed, True, args.repeat),
-    }
-    bare = character.create({"params": {}}, rigged=False, exact=True).root
-    rigged = character.create({"params": {}, "clothes": dressed}, exact=True).root
-    results["bare change"] = _time_changes(bare, args.repeat)
-    results["dressed change"] = _time_changes(rigged, args.repeat)
-    results["dressed settle"] = _time_settle(bpy, rigged, args.repeat)
-    anchor = _time_rebuild(rigged, max(3, args.repeat // 3))
-    _report(bpy, results, anchor, dressed)
+    results: dict[str, Times] = {}
+    results["create"] = _alternate(_avatar_create([], False), mpfb and _mpfb_create(mpfb, None),
+                                   args.repeat)  # fmt: skip
+    scene.clear_scene()
+    results["dressed create"] = _alternate(_avatar_create(dressed, True),
+                                           mpfb and _mpfb_create(mpfb, assets), args.repeat)
+    scene.clear_scene()
+    refits: list[tuple[float, float]] = []
+    results["bare change"] = _alternate(_avatar_change([], False),
+                                        mpfb and _mpfb_change(mpfb, None, []), args.repeat)
+    results["dressed change"] = _alternate(_avatar_change(dressed, True),
+                                           mpfb and _mpfb_change(mpfb, assets, refits),
+                                           args.repeat)  # fmt: skip
+    extra = {"Avatar dressed settle": _time_settle(dressed, args.repeat)}
+    if assets:  # Avatar's own look, as without --mpfb (no MPFB2 equivalent)
+        scene.clear_scene()
+        builtin = ["hair-short", "eyebrows", "eyelashes", *args.garments.split(",")]
+        extra["Avatar dressed create, built-ins: " + ", ".join(builtin)] = _alternate(
+            _avatar_create(builtin, True), None, args.repeat)[0]
+    anchor = _time_rebuild(dressed, max(3, args.repeat // 3))
+    scene.clear_scene()
+    _report(bpy, mpfb, results, refits, extra, anchor, dressed, (load_before, os.getloadavg()))
 
 
-def _parse() -> argparse.Namespace:
+def _parse(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=15)
-    parser.add_argument("--garments", default="tshirt,jeans,shoes")
-    parser.add_argument("--mpfb", type=Path, help="an MPFB2 checkout (not driven yet)")
-    args = parser.parse_args()
-    if args.mpfb is not None:
-        sys.exit("--mpfb: driving MPFB2 is not implemented; the issue's figures are printed")
+    parser.add_argument("--garments", default="tshirt,jeans,shoes",
+                        help="Avatar's built-in garments worn without --mpfb/--assets")
+    parser.add_argument("--mpfb", type=Path, help="an MPFB2 checkout to time side by side")
+    parser.add_argument("--assets", type=Path,
+                        help="MakeHuman assets folder for the dressed human (with --mpfb: "
+                        f"default {FIXTURES})")  # fmt: skip
+    args = parser.parse_args(argv)
+    if args.repeat < 1:
+        parser.error("--repeat must be at least 1")
     return args
+
+
+def _assets(args: argparse.Namespace) -> list[Path] | None:
+    """The ``.mhclo`` files of the dressed human when MakeHuman assets are used, else None."""
+    folder = args.assets or (FIXTURES if args.mpfb else None)
+    if folder is None:
+        return None
+    paths = [folder / item for item in MAKEHUMAN_LOOK]
+    missing = [str(p) for p in paths if not p.is_file()]
+    if missing:
+        sys.exit(f"--assets {folder}: missing {', '.join(missing)}")
+    return paths
+
+
+def _register_mpfb(args: argparse.Namespace, assets: list[Path] | None):
+    if args.mpfb is None:
+        return None
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import mpfb_driver
+
+    try:
+        source = mpfb_driver.find_source(args.mpfb)
+        return mpfb_driver.Mpfb(source, assets[0].parents[2] if assets else None)
+    except mpfb_driver.MpfbError as exc:
+        sys.exit(f"--mpfb: {exc}")
 
 
 def _build_zip() -> Path:
     spec = importlib.util.spec_from_file_location("avatar_addon_build", ROOT / "addon/build.py")
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up
     spec.loader.exec_module(module)
     return module.main(["--output", tempfile.mkdtemp(prefix="avatar-bench-zip-"), "--no-wheel"])
 
 
-def _time_create(bpy, clothes, rigged, repeat) -> list[float]:
-    """Seconds of ``character.create`` (real-time garment fit, as the Create button), each
-    human added next to the others, as a user adds them (they share materials)."""
-    from avatar.blender import character, scene
+Times = tuple[list[float], list[float] | None]  # Avatar's seconds, MPFB2's (None: not run)
 
-    times = []
-    for _ in range(repeat + 1):
+
+def _alternate(avatar: Step, mpfb: Step | None, repeat: int) -> Times:
+    """Seconds of each side per repeat, after one warm-up; with MPFB2, the two are run one
+    after the other, the order swapped every repeat."""
+    ours: list[float] = []
+    theirs: list[float] = []
+    for i in range(repeat + 1):
+        if mpfb is not None and i % 2:
+            b = mpfb(i)
+            a = avatar(i)
+        else:
+            a = avatar(i)
+            b = mpfb(i) if mpfb is not None else 0.0
+        if i:
+            ours.append(a)
+            theirs.append(b)
+    return ours, (theirs if mpfb is not None else None)
+
+
+def _value(i: int) -> float:
+    """The slider value of repeat ``i``: alternately lighter and heavier, never the same."""
+    return 0.3 + 0.4 * (i % 2) + 0.001 * i
+
+
+def _avatar_create(clothes: list[str], rigged: bool) -> Step:
+    """``character.create`` (as the Create button; real-time garment fit), each human added
+    next to the others, as a user adds them (they share materials)."""
+    from avatar.blender import character
+
+    def step(i: int) -> float:
         start = time.perf_counter()
         character.create({"params": {}, "clothes": clothes}, rigged=rigged, exact=False)
-        times.append(time.perf_counter() - start)
-    scene.clear_scene()
-    return times[1:]
+        return time.perf_counter() - start
+
+    return step
 
 
-def _time_changes(root, repeat) -> list[float]:
-    """Seconds of one ``obj.avatar.weight = v`` (what a slider step does)."""
-    times = []
-    for i in range(repeat + 1):
+def _mpfb_create(mpfb, assets: list[Path] | None) -> Step:
+    def step(i: int) -> float:
         start = time.perf_counter()
-        root.avatar.weight = 0.3 + 0.4 * (i % 2) + 0.001 * i
-        times.append(time.perf_counter() - start)
-    return times[1:]
+        basemesh = mpfb.create()
+        if assets is not None:
+            mpfb.dress(basemesh, assets)
+        return time.perf_counter() - start
+
+    return step
 
 
-def _time_settle(bpy, root, repeat) -> list[float]:
-    from avatar.blender import live
+def _avatar_change(clothes: list[str], rigged: bool) -> Step:
+    """One ``obj.avatar.weight = v`` (what a slider step does) on a character made here."""
+    from avatar.blender import character
 
+    root = character.create({"params": {}, "clothes": clothes}, rigged=rigged, exact=True).root
+
+    def step(i: int) -> float:
+        start = time.perf_counter()
+        setattr(root.avatar, MACRO, _value(i))
+        return time.perf_counter() - start
+
+    return step
+
+
+def _mpfb_change(mpfb, assets: list[Path] | None, parts: list[tuple[float, float]]) -> Step:
+    """MPFB2's macro slider (+ refit when dressed) on a human made here; ``parts`` collects
+    (slider, refit) seconds per repeat."""
+    basemesh = mpfb.create()
+    if assets is not None:
+        mpfb.dress(basemesh, assets)
+
+    def step(i: int) -> float:
+        slider, refit = mpfb.change(basemesh, MACRO, _value(i), refit=assets is not None)
+        if i:
+            parts.append((slider, refit))
+        return slider + refit
+
+    return step
+
+
+def _time_settle(clothes: list[str], repeat: int) -> list[float]:
+    from avatar.blender import character, live
+
+    root = character.create({"params": {}, "clothes": clothes}, exact=True).root
     times = []
     for i in range(repeat):
-        root.avatar.weight = 0.4 + 0.01 * i
+        setattr(root.avatar, MACRO, 0.4 + 0.01 * i)
         start = time.perf_counter()
         live.settle(root)
         times.append(time.perf_counter() - start)
     return times
 
 
-def _time_rebuild(root, repeat) -> list[float]:
+def _time_rebuild(clothes: list[str], repeat: int) -> list[float]:
     """The anchor: a whole rebuild of the dressed character (the old Update button)."""
-    import json
-
     from avatar import export
     from avatar.blender import character, scene
     from avatar.human import Human
 
-    recipe = json.loads(root["avatar_recipe"])
+    recipe = {"params": {}, "clothes": clothes}
     times = []
-    for i in range(repeat):
-        recipe["params"]["weight"] = 0.35 + 0.01 * i
+    for i in range(repeat + 1):
+        recipe["params"] = {MACRO: 0.35 + 0.01 * i}
         start = time.perf_counter()
         human = Human.from_recipe(recipe)
         built = scene.build_character(export.character(human, name="anchor"))
         times.append(time.perf_counter() - start)
         character.remove(built.root)
-    return times
+    return times[1:]
 
 
-def _report(bpy, results, anchor, dressed) -> None:
+def _report(bpy, mpfb, results, refits, extra, anchor, dressed, loads) -> None:
+    print()
     print(f"bpy {bpy.app.version_string}, {os.cpu_count()} cores, "
-          f"OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}")  # fmt: skip
-    print(f"dressed = {', '.join(dressed)}; medians (min-max), seconds")
-    rebuild = statistics.median(anchor)
-    print(f"  anchor: whole rebuild (old Update)   {rebuild:8.4f}")
-    for name, times in results.items():
-        median = statistics.median(times)
-        line = f"  {name:<16} {median:8.4f} ({min(times):.4f}-{max(times):.4f})"
-        line += f"  x{rebuild / median:6.1f} faster than the rebuild"
-        if name in MPFB2:
-            line += f", x{MPFB2[name] / median:5.1f} vs MPFB2's {MPFB2[name]:g}"
+          f"OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', 'unset')}, load average "
+          f"{loads[0][0]:.2f} before, {loads[1][0]:.2f} after")  # fmt: skip
+    other = mpfb.source.describe() + " in this process" if mpfb else "MPFB2 2.0.17 (issue 13)"
+    print(f"Avatar vs {other}; dressed = {', '.join(Path(d).stem for d in dressed)}"
+          + (", rig default (163 bones) on both" if mpfb else ""))
+    print("medians (min-max) in seconds; ratio = MPFB2 / Avatar")
+    print(f"  {'step':<38} {'Avatar':>24} {'MPFB2':>24} {'ratio':>7}  goal")
+    for name, (ours, theirs) in results.items():
+        median = statistics.median(ours)
+        if theirs is not None:
+            their = statistics.median(theirs)
+            their_text = f"{their:8.4f} ({min(theirs):.4f}-{max(theirs):.4f})"
+        else:
+            their = ISSUE_MPFB2[name]
+            their_text = f"{their:8.4f} (issue)" + " " * 7
+        line = (f"  {LABELS[name]:<38} {median:8.4f} ({min(ours):.4f}-{max(ours):.4f})"
+                f" {their_text} {their / median:6.1f}x")  # fmt: skip
         if name in GOALS:
-            line += f", goal {GOALS[name]:g}: {'met' if median < GOALS[name] else 'MISSED'}"
+            limit, factor = GOALS[name]
+            met = median < limit and their / median >= factor
+            line += f"  < {limit * 1000:g} ms, >= {factor:g}x: {'met' if met else 'MISSED'}"
         print(line)
+    if refits:
+        slider = statistics.median(s for s, _ in refits)
+        refit = statistics.median(r for _, r in refits)
+        print(f"  MPFB2's dressed change = macro slider {slider:.4f} + HumanService.refit "
+              f"{refit:.4f} (medians)")  # fmt: skip
+    rebuild = statistics.median(anchor)
+    print(f"  anchor: Avatar whole rebuild of the dressed human (old Update) {rebuild:8.4f}")
+    for name, times in extra.items():
+        median = statistics.median(times)
+        print(f"  {name}: {median:.4f} ({min(times):.4f}-{max(times):.4f}), "
+              f"x{rebuild / median:.1f} faster than the rebuild")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -1,0 +1,176 @@
+"""MPFB2 driven in this bpy process through its own operators and services, for
+``bench/blender.py --mpfb``: nothing of MPFB2 is copied here (it is GPL), only called.
+
+What each call does is what an MPFB2 user's click does (2.0.17's code paths):
+
+- ``create``: ``bpy.ops.mpfb.create_human()`` (New human > Create, panel defaults);
+- ``dress``: ``bpy.ops.mpfb.add_standard_rig()`` with the rig set to ``default`` (MakeHuman's
+  163-bone rig, Avatar's default; MPFB2's panel default is ``default_no_toes``), then one
+  ``bpy.ops.mpfb.load_library_clothes(filepath=..., object_type=...)`` per asset, as the
+  asset library's Load button does with its default settings (fit to body, delete group,
+  rigging with interpolated weights, a subdivision modifier at viewport level 0);
+- ``change``: the Model panel's macro slider, ``scene.mpfb_macropanel_<macro> = v`` with the
+  basemesh active (``TargetService.reapply_macro_details`` with shape-key pruning, the panel
+  default), then, for a dressed human, ``HumanService.refit(basemesh)``: what the panel's
+  "Auto refit assets" option calls after the macros (clothes, body parts and rig refitted).
+
+The MakeHuman assets are found by MPFB2 itself through its "second root" preference (a user
+asset folder), because its refit looks garments up by name in its asset roots.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import time
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import addon_utils  # noqa: TID251 (Blender's add-on loader: bench only)
+import bpy  # noqa: TID251 (this file drives MPFB2 inside Blender: bench only)
+
+MODULE = "bl_ext.user_default.mpfb"  # the name Blender gives the extension in its user repo
+# MPFB2's object_type for an asset folder's category (MakeHuman's library layout).
+KINDS = {"clothes": "Clothes", "hair": "Hair", "eyebrows": "Eyebrows", "eyelashes": "Eyelashes",
+         "eyes": "Eyes", "teeth": "Teeth", "tongue": "Tongue"}  # fmt: skip
+
+
+class MpfbError(RuntimeError):
+    """MPFB2 cannot be registered or driven (one line for the bench to print)."""
+
+
+@dataclass(frozen=True)
+class Source:
+    """Which MPFB2 is driven: its package folder, version and (when known) commit."""
+
+    package: Path
+    version: str
+    commit: str | None
+
+    def describe(self) -> str:
+        return f"MPFB2 {self.version}" + (f" ({self.commit[:10]})" if self.commit else "")
+
+
+def find_source(path: Path) -> Source:
+    """The MPFB2 package under ``path``: a checkout's root (``src/mpfb``), ``src/`` or the
+    package folder itself. Raises MpfbError when none is there or its data is incomplete."""
+    candidates = [path, path / "mpfb", path / "src" / "mpfb"]
+    package = next((p for p in candidates if (p / "blender_manifest.toml").is_file()), None)
+    if package is None:
+        raise MpfbError(f"{path}: no MPFB2 package (src/mpfb/blender_manifest.toml) there")
+    manifest = tomllib.loads((package / "blender_manifest.toml").read_text())
+    if manifest.get("id") != "mpfb":
+        raise MpfbError(f"{package}: its manifest's id is {manifest.get('id')!r}, not 'mpfb'")
+    weights = package / "data/rigs/standard/weights.default.json"
+    if not weights.is_file() or weights.stat().st_size < 1000:
+        raise MpfbError(f"{weights}: missing or a placeholder (a partial clone? "
+                        "bench/mpfb_checkout.py fills it)")  # fmt: skip
+    return Source(package.resolve(), str(manifest.get("version")), _commit(package))
+
+
+def _commit(package: Path) -> str | None:
+    """The commit of the checkout ``package`` is in: ``SOURCE.txt`` (bench/mpfb_checkout.py)
+    or the git repository around it."""
+    for folder in package.parents:
+        record = folder / "SOURCE.txt"
+        if record.is_file():
+            return record.read_text().split()[2]
+        head = folder / ".git"
+        if head.exists():
+            import subprocess
+
+            done = subprocess.run(["git", "-C", str(folder), "rev-parse", "HEAD"],
+                                  capture_output=True, text=True)  # fmt: skip
+            return done.stdout.strip() or None
+    return None
+
+
+class Mpfb:
+    """MPFB2 registered in this process (``register`` once), with handles on the services and
+    panel settings its operators read."""
+
+    def __init__(self, source: Source, assets: Path | None) -> None:
+        self.source = source
+        repo = Path(bpy.utils.user_resource("EXTENSIONS", path="user_default", create=True))
+        link = repo / "mpfb"
+        if not link.exists():
+            os.symlink(source.package, link)  # installed as a user extension, not copied
+        bpy.ops.extensions.repo_refresh_all()
+        # register() builds MPFB2's panels, properties and services (about a second).
+        if addon_utils.enable(MODULE, default_set=True, handle_error=_raise) is None:
+            raise MpfbError(f"{source.package}: MPFB2 did not register")
+        self.services = importlib.import_module(MODULE + ".services")
+        self.rig_settings = importlib.import_module(
+            MODULE + ".ui.rigging.standardrig.standardrigpanel").STANDARD_RIG_PROPERTIES
+        self.model_settings = importlib.import_module(
+            MODULE + ".ui.model.modelpanel").MODEL_PROPERTIES
+        scene = bpy.context.scene
+        self.rig_settings.set_value("standard_rig", "default", entity_reference=scene)
+        self.model_settings.set_value("refit", False, entity_reference=scene)  # refit: ours
+        if assets is not None:
+            bpy.context.preferences.addons[MODULE].preferences.mpfb_second_root = str(assets)
+            self.services.LocationService.update_second_root()
+
+    def create(self) -> bpy.types.Object:
+        """A new default human (MPFB2's basemesh), made the active object."""
+        _check(bpy.ops.mpfb.create_human(), "create_human")
+        return bpy.context.active_object
+
+    def dress(self, basemesh: bpy.types.Object, assets: list[Path]) -> None:
+        """Give ``basemesh`` the default rig, then each ``.mhclo`` of ``assets`` in order."""
+        _activate(basemesh)
+        _check(bpy.ops.mpfb.add_standard_rig(), "add_standard_rig")
+        for path in assets:
+            _activate(basemesh)
+            kind = KINDS.get(path.parent.parent.name.lower(), "Clothes")
+            _check(bpy.ops.mpfb.load_library_clothes(filepath=str(path), object_type=kind),
+                   f"load_library_clothes {path.name}")  # fmt: skip
+
+    def change(self, basemesh: bpy.types.Object, macro: str, value: float,
+               refit: bool) -> tuple[float, float]:  # fmt: skip
+        """Move the Model panel's ``macro`` slider of ``basemesh`` to ``value``; ``refit``:
+        then refit its clothes and rig as Auto refit does. Seconds of (slider, refit)."""
+        _activate(basemesh)
+        start = time.perf_counter()
+        setattr(bpy.context.scene, "mpfb_macropanel_" + macro, value)
+        middle = time.perf_counter()
+        if refit:
+            self.services.HumanService.refit(basemesh)
+        end = time.perf_counter()
+        now = getattr(bpy.context.scene, "mpfb_macropanel_" + macro)  # read from the basemesh
+        if abs(now - value) > 1e-4:
+            raise MpfbError(f"MPFB2's {macro} slider reads {now}, not {value}, after the change")
+        return middle - start, end - middle
+
+
+def remove(basemesh: bpy.types.Object) -> None:
+    """Delete an MPFB2 human: its root (rig or basemesh), everything under it and their data."""
+    root = basemesh.parent or basemesh
+    objects = [root, *root.children_recursive]
+    datas = [o.data for o in objects if o.data is not None]
+    materials = [m for d in datas for m in getattr(d, "materials", []) if m is not None]
+    for obj in objects:
+        bpy.data.objects.remove(obj)
+    for block in (*datas, *materials):
+        if block.users == 0:
+            pool = {bpy.types.Mesh: bpy.data.meshes, bpy.types.Armature: bpy.data.armatures,
+                    bpy.types.Material: bpy.data.materials}.get(type(block))  # fmt: skip
+            if pool is not None:
+                pool.remove(block)
+
+
+def _activate(obj: bpy.types.Object) -> None:
+    for other in bpy.context.selected_objects:
+        other.select_set(False)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+
+
+def _check(result: set[str], what: str) -> None:
+    if result != {"FINISHED"}:
+        raise MpfbError(f"MPFB2's {what} returned {sorted(result)}")
+
+
+def _raise(exc: BaseException) -> None:
+    raise MpfbError(f"MPFB2 failed to register: {exc}") from exc
