@@ -108,6 +108,9 @@ class VmcAssembler:
         except Exception:  # python-osc raises several types on garbage; all mean malformed
             self.counters.drop("malformed")
             return []
+        if not messages:  # python-osc skips bundle elements it cannot parse, with a warning
+            self.counters.drop("malformed")
+            return []
         # In a bundle the frame completes at its end: senders put /VMC/Ext/T after OK.
         bundle = datagram[:8] == b"#bundle\x00"
         out: list[Frame] = []
