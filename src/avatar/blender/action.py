@@ -67,12 +67,19 @@ def new_action(owner, id_type: str, name: str):
     if not has_slots():
         owner.animation_data.action = action
         return action, action
-    from bpy_extras import anim_utils
-
     slot = action.slots.new(id_type=id_type, name=owner.name)
     owner.animation_data.action = action
     owner.animation_data.action_slot = slot
-    return action, anim_utils.action_ensure_channelbag_for_slot(action, slot)
+    return action, _ensure_channelbag(action, slot)
+
+
+def _ensure_channelbag(action: bpy.types.Action, slot):
+    """The slot's channelbag on the action's first keyframe strip, made if missing (what
+    ``bpy_extras.anim_utils.action_ensure_channelbag_for_slot`` does from 4.5; Blender 4.4
+    has slots but not that function)."""
+    layer = action.layers[0] if len(action.layers) else action.layers.new("Layer")
+    strip = layer.strips[0] if len(layer.strips) else layer.strips.new(type="KEYFRAME")
+    return strip.channelbag(slot, ensure=True)
 
 
 def has_slots() -> bool:
