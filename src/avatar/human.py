@@ -25,7 +25,7 @@ from avatar.body import shaped
 from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
-from avatar.clothes import footing, library
+from avatar.clothes import face, footing, library
 from avatar.clothes.asset import material_from_file
 from avatar.clothes.outfit import Outfit
 from avatar.errors import ParameterError, unknown_name
@@ -265,6 +265,8 @@ class Human:
         base = self.model.base
         faces = np.sort(np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]]))
         mesh = base.with_vertices(self.vertices).subset(faces)
+        if name == "teeth":  # spread over the teeth-and-gums texture (looks.skin)
+            return face.teeth_uvs(mesh, np.isin(faces, base.face_groups["helper-upper-teeth"]))
         return _eye_uvs(mesh, faces, base) if name == "eyes" else mesh
 
     def part_vertices(self, name: str) -> np.ndarray:

@@ -88,3 +88,36 @@ def _hops(faces: np.ndarray, count: int, sources: list[int]) -> np.ndarray:
         if np.array_equal(new, dist):
             return dist
         dist = new
+
+
+def teeth_uvs(mesh: Mesh, upper: np.ndarray) -> Mesh:
+    """The teeth part (both rows of the base mesh's teeth helpers) with UVs over the teeth
+    texture (``looks.skin.teeth_texture``): u along the arch by length from one end (0) to
+    the other (1), v from the gum side of the strip (1) over the outer face, the biting
+    edge and the inner face (0).
+
+    mesh: the teeth part, quads; upper: (F,) bool, its faces of the upper row. Each row is
+    a grid strip four vertices deep; the gum side is its long boundary side highest up
+    (upper row) or lowest down (lower row). Returns the mesh with one UV per face corner.
+    """
+    corners = np.zeros(mesh.faces.shape + (2,), np.float32)
+    for rows, down in ((upper, 1.0), (~upper, -1.0)):
+        faces = mesh.faces[rows]
+        used, local = np.unique(faces, return_inverse=True)
+        points = mesh.vertices[used]
+        strip = Mesh(points, local.reshape(faces.shape).astype(np.int32))
+        # Far above (upper) or below (lower): the nearest long side is the gum side.
+        uv = strip_uvs(strip, points.mean(axis=0) + [0.0, 0.0, down])
+        uv[:, 0] = _arch_length(points, uv)
+        uv[:, 1] = 1.0 - uv[:, 1]
+        corners[rows] = uv[local.reshape(faces.shape)]
+    return per_corner(mesh, corners.reshape(-1, 2))
+
+
+def _arch_length(points: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(V,) u of a teeth strip by length along the arch: each column's distance from the
+    first, measured along the gum-side row and normalised to [0, 1]."""
+    columns = np.unique(uv[:, 0])
+    gum = np.stack([points[(uv[:, 0] == c) & (uv[:, 1] == 0)].mean(axis=0) for c in columns])
+    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(gum, axis=0), axis=1))])
+    return np.interp(uv[:, 0], columns, length / length[-1]).astype(np.float32)

@@ -51,7 +51,7 @@ REGIONS = {
     "inside-mouth": ("mpfb_inside-mouth.jpg", None, 0.2),
 }
 NAIL_SRGB = (236, 205, 198)
-MOUTH_SRGB = (150, 62, 66)
+MOUTH_SRGB = (176, 84, 88)  # the mouth's lining: seen in shadow, so not too dark
 # Islands of other helper geometry that share the body's UV space (u0, v0, u1, v1),
 # measured on base.obj: teeth and tongue get their own colours so they are not skin.
 TEETH_UV = (0.675, 0.87, 0.742, 0.90)
@@ -345,15 +345,22 @@ def _paint_mouth_parts(colour, rough) -> None:
 # ---------------------------------------------------------------------------- mouth
 
 MOUTH_PARTS = ("teeth", "tongue")
+GUM_SRGB = (204, 104, 110)  # healthy gums: coral pink, wet
+# Tooth widths (mm) from the midline back: incisors, canine, premolars, molars; the
+# teeth texture spreads them over each half of the arch.
+TOOTH_MM = (8.5, 6.5, 7.5, 7.0, 6.5, 10.0, 9.0)
+ARCH_MM, STRIP_MM = 110.0, 22.0  # the teeth strip's length along the arch and across it
 
 
 def mouth_material(part: str, age: float = 0.5) -> Material:
-    """The material of a mouth part of the base mesh ("teeth" or "tongue"), plain colour.
+    """The material of a mouth part of the base mesh ("teeth" or "tongue").
 
     Teeth: glossy enamel, ivory that yellows a little with ``age`` (0..1, MakeHuman's age
-    macro), translucent at the edges (a little subsurface). Tongue: wet, pink-red, with
-    subsurface scattering like the lips. Both are seen in shadow inside the mouth, so a
-    factor without texture reads right and costs nothing to export.
+    macro), translucent at the edges (a little subsurface), with gums: the teeth texture
+    (``teeth_texture``, for the teeth part's UVs ``clothes.face.teeth_uvs``) draws pink
+    gums with a scalloped line over each tooth and the gaps between teeth; ``base_color``
+    is the enamel's tint. Tongue: wet, pink-red, with subsurface scattering like the lips,
+    a plain colour (seen in shadow inside the mouth).
     """
     if part not in MOUTH_PARTS:
         raise ValueError(f"mouth part must be one of {MOUTH_PARTS}, got {part!r}")
@@ -361,11 +368,58 @@ def mouth_material(part: str, age: float = 0.5) -> Material:
     if part == "teeth":
         srgb = np.array(TEETH_SRGB, np.float32) * (1.0, 1.0 - 0.03 * old, 1.0 - 0.12 * old)
         r, g, b = (float(c) for c in srgb_to_linear(srgb / 255.0))
-        return Material(name="teeth", base_color=(r, g, b, 1.0), roughness=0.18,
-                        extras={"subsurface": 0.1, "subsurface_radius": [0.004, 0.003, 0.002]})
+        return Material(
+            name="teeth",
+            base_color=(r, g, b, 1.0),
+            roughness=0.2,
+            base_color_texture=teeth_texture(),
+            extras={"subsurface": 0.1, "subsurface_radius": [0.004, 0.003, 0.002]},
+        )
     r, g, b = (float(c) for c in srgb_to_linear(np.array(TONGUE_SRGB, np.float32) / 255.0))
-    return Material(name="tongue", base_color=(r, g, b, 1.0), roughness=0.3,
-                    extras={"subsurface": 0.2, "subsurface_radius": [0.01, 0.004, 0.0025]})
+    return Material(
+        name="tongue",
+        base_color=(r, g, b, 1.0),
+        roughness=0.3,
+        extras={"subsurface": 0.2, "subsurface_radius": [0.01, 0.004, 0.0025]},
+    )
+
+
+@functools.lru_cache(maxsize=2)
+def teeth_texture(width: int = 512, height: int = 256) -> np.ndarray:
+    """(height, width, 3) uint8 sRGB teeth and gums, relative to the enamel's tint (the
+    material's ``base_color`` multiplies it: enamel is white here, gums are pink divided by
+    the tint). Layout (``clothes.face.teeth_uvs``): u along the arch, v from the gum side
+    (1) over the outer face down to the biting edge (v = 1/3) and up the inner face (0).
+
+    Gums cover a band along both long sides, scalloped: about 3 mm over each tooth's
+    middle, dipping 6 mm between teeth (the papillae); the gaps between teeth darken, and
+    the biting edge is a little grey-blue (thin enamel)."""
+    u = (np.arange(width, dtype=np.float32) + 0.5) / width
+    v = 1.0 - (np.arange(height, dtype=np.float32) + 0.5) / height
+    # Position within a tooth along the arch (0..1) and distance to its nearest gap (mm).
+    bounds = np.cumsum((0.0,) + TOOTH_MM) / sum(TOOTH_MM) * 0.5  # half arch, from the middle
+    side = np.abs(u - 0.5)
+    k = np.clip(np.searchsorted(bounds, side) - 1, 0, len(TOOTH_MM) - 1)
+    within = np.clip((side - bounds[k]) / (bounds[k + 1] - bounds[k]), 0, 1)
+    gap_mm = np.minimum(within, 1 - within) * np.asarray(TOOTH_MM)[k]
+    scallop = 3.0 + 2.5 * (1 - np.sin(np.pi * within)) ** 1.5  # gum depth (mm) along u
+    outer_mm = (1.0 - v)[:, None] * STRIP_MM  # depth from the gum side
+    inner_mm = v[:, None] * STRIP_MM  # from the inner side
+    px = STRIP_MM / height  # one pixel in mm, for anti-aliased edges
+    gum = np.maximum(np.clip((scallop[None, :] - outer_mm) / px + 0.5, 0, 1),
+                     np.clip((0.8 * scallop[None, :] - inner_mm) / px + 0.5, 0, 1))  # fmt: skip
+    gap = np.exp(-((gap_mm / 0.45) ** 2))[None, :] * np.ones_like(outer_mm)
+    edge = np.exp(-(((v - 1 / 3) * STRIP_MM / 1.5) ** 2))[:, None]  # biting edge
+    enamel = np.ones((height, width, 3), np.float32)
+    enamel *= (1 - 0.55 * gap)[..., None]
+    enamel *= 1 + (np.array([0.85, 0.9, 0.98], np.float32) - 1) * edge[..., None]
+    tint = srgb_to_linear(np.array(TEETH_SRGB, np.float32) / 255.0)
+    pink = np.clip(_linear(GUM_SRGB) / tint, 0, 1)
+    margin = 1 + 0.15 * np.exp(-(((gum - 0.5) * 2) ** 2))  # a lighter rim at the gum line
+    colour = enamel * (1 - gum[..., None]) + (pink * margin[..., None]) * gum[..., None]
+    image = _to_uint8(np.clip(colour, 0, 1))
+    image.flags.writeable = False
+    return image
 
 
 # ---------------------------------------------------------------------------- eyes
