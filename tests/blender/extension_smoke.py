@@ -67,6 +67,7 @@ def main() -> int:
         check_installed_from(user)
     if args.layouts:
         check_layouts(bpy)
+    check_engine_ids(bpy)
     from avatar.blender import action, armature, live, mesh
     from avatar.body.shaped import PART_GROUPS
     from avatar.human import Human
@@ -117,6 +118,19 @@ def main() -> int:
     assert not hasattr(bpy.types, "AVATAR_PT_body")
     print("unregister ok")
     return 0
+
+
+def check_engine_ids(bpy) -> None:
+    """Either EEVEE id (BLENDER_EEVEE_NEXT in 4.2-4.5, BLENDER_EEVEE in 5.x) is accepted."""
+    from avatar.blender import render
+
+    scene = bpy.context.scene
+    before = scene.render.engine
+    for name in ("BLENDER_EEVEE", "BLENDER_EEVEE_NEXT", "CYCLES", "BLENDER_WORKBENCH"):
+        scene.render.engine = render.engine_id(name)
+        assert scene.render.engine.startswith(name.removesuffix("_NEXT")), name
+    scene.render.engine = before
+    print("engine ids ok")
 
 
 def check_nothing_installed() -> None:

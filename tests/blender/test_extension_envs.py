@@ -9,7 +9,9 @@ wear, error reports, Apply with slotted or legacy actions, unregister).
   as GLB, and its panels' UILayout calls exist in that Blender. In this venv's bpy 5.0.1, in
   pip bpy 4.2 LTS (no slotted actions) from the venv named by ``AVATAR_BPY42_PYTHON``
   (default /tmp/bpy42/bin/python: ``python3.11 -m venv /tmp/bpy42 && /tmp/bpy42/bin/pip
-  install bpy==4.2.0``), and in pip bpy 5.1+ on Python 3.13 from ``AVATAR_BPY5X_PYTHON``
+  install bpy==4.2.0``), in pip bpy 4.4 (slotted actions without
+  ``anim_utils.action_ensure_channelbag_for_slot``) from ``AVATAR_BPY44_PYTHON`` (default
+  /tmp/bpy44/bin/python), and in pip bpy 5.1+ on Python 3.13 from ``AVATAR_BPY5X_PYTHON``
   (default /tmp/bpy52/bin/python: ``python3.13 -m venv /tmp/bpy52 && /tmp/bpy52/bin/pip
   install bpy==5.2.*``), with the Python 3.13 zip;
 - this venv's bpy with the checkout's zip (``--no-wheel``) and pygltflib made unimportable:
@@ -33,6 +35,7 @@ from test_extension import FIXTURES, ROOT, load_build_script
 SMOKE = Path(__file__).with_name("extension_smoke.py")
 WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
 BPY42 = os.environ.get("AVATAR_BPY42_PYTHON", "/tmp/bpy42/bin/python")
+BPY44 = os.environ.get("AVATAR_BPY44_PYTHON", "/tmp/bpy44/bin/python")
 BPY5X = os.environ.get("AVATAR_BPY5X_PYTHON", "/tmp/bpy52/bin/python")
 
 
@@ -163,6 +166,15 @@ def test_the_zip_alone_makes_a_dressed_human_in_blender_4_2(full_zips, tmp_path)
     out = _smoke_zip_alone(BPY42, full_zips("3.11"), tmp_path)
     assert "blender 4.2" in out
     assert "motion ok: slotted actions False" in out or not WALK.is_file()
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+@pytest.mark.skipif(not Path(BPY44).is_file(), reason=f"no bpy 4.4 venv at {BPY44}")
+def test_the_zip_alone_makes_a_dressed_human_in_blender_4_4(full_zips, tmp_path):
+    out = _smoke_zip_alone(BPY44, full_zips("3.11"), tmp_path)
+    assert "blender 4.4" in out
+    assert "motion ok: slotted actions True" in out or not WALK.is_file()
 
 
 @pytest.mark.slow

@@ -64,7 +64,23 @@ def configure(
     elif engine == "WORKBENCH":
         _configure_workbench(scene)
     else:
-        settings.engine = engine  # e.g. EEVEE ("BLENDER_EEVEE_NEXT" before 5.0)
+        settings.engine = engine_id(engine)
+
+
+# EEVEE's engine id is BLENDER_EEVEE_NEXT in Blender 4.2-4.5 and BLENDER_EEVEE again from 5.0.
+_EEVEE_IDS = ("BLENDER_EEVEE", "BLENDER_EEVEE_NEXT")
+
+
+def engine_id(engine: str) -> str:
+    """``engine`` as this Blender names it: either EEVEE id becomes the one it accepts."""
+    if engine not in _EEVEE_IDS:
+        return engine
+    settings = bpy.types.RenderSettings.bl_rna.properties["engine"]
+    known = {item.identifier for item in settings.enum_items}
+    found = [e for e in (engine, *_EEVEE_IDS) if e in known]
+    if found:
+        return found[0]
+    return "BLENDER_EEVEE_NEXT" if bpy.app.version < (5, 0) else "BLENDER_EEVEE"
 
 
 def set_resolution(scene: bpy.types.Scene, resolution: int | tuple[int, int]) -> None:
