@@ -5,8 +5,10 @@ blocking) and registers ``tick`` with ``bpy.app.timers`` (60 Hz): each tick take
 newest pose and writes it into the armature's pose bones in two array writes
 (``avatar.blender.mocap_drive.PoseWriter``). With Record on, every frame the sender
 completed is kept and Stop keys them into a new Action, one key per frame at the sender's
-rate. Stop (or ``release()`` when the add-on is disabled) closes the socket, removes the
-timer and writes the take. If the character disappears the timer stops itself.
+rate; with Bake Garments it then saves the take as BVH and rebuilds the character playing
+it, as the Motion panel's Apply does (garments with per-frame corrections). Stop (or
+``release()`` when the add-on is disabled) closes the socket, removes the timer and
+writes the take. If the character disappears the timer stops itself.
 
 Headless scripts, where timers do not run, call ``tick()`` themselves.
 """
@@ -69,6 +71,14 @@ class AvatarMocapSettings(bpy.types.PropertyGroup):
     record: BoolProperty(name="Record", default=False,
                          description="Keep every received frame; Stop keys them into a new "
                          "Action (one key per frame, at the sender's rate)")  # fmt: skip
+    bake_garments: BoolProperty(
+        name="Bake Garments",
+        default=False,
+        description="On Stop, save the take as BVH (mocap_takes/ beside the .blend file, or "
+        "the system's temporary folder) and apply it as the Motion panel does: the character "
+        "is rebuilt playing it, its garments with per-frame corrections (the exact resolve: "
+        "about 45 ms a frame, so Stop waits)",
+    )
 
 
 class _Live:
@@ -184,9 +194,10 @@ def tick():
     return INTERVAL
 
 
-def stop(message: str | None = None) -> str:
+def stop(message: str | None = None, bake: bool = True) -> str:
     """End the session: socket closed, timer removed, the take (if any) keyed into a new
-    Action on the armature. Returns the closing line (also shown in the panel)."""
+    Action on the armature (and, with ``bake`` and the scene's Bake Garments, applied as a
+    motion with garment corrections). Returns the closing line (also shown in the panel)."""
     global _LIVE
     live, _LIVE = _LIVE, None
     if bpy.app.timers.is_registered(tick):
@@ -204,6 +215,8 @@ def stop(message: str | None = None) -> str:
             scene = bpy.data.scenes.get(live.scene)
             act = mocap_drive.write_take(arm, take, f"{arm.name} take", scene=scene)
             line += f"; {take.frames} frames at {take.fps:g} fps keyed into '{act.name}'"
+            if bake and scene is not None and scene.avatar_mocap.bake_garments:
+                line += _bake(arm, live.session.skeleton, take)
         else:
             mocap_drive.restore_action(arm, live.held_action)
     elif take is not None:
@@ -216,6 +229,47 @@ def stop(message: str | None = None) -> str:
     return line
 
 
+def _bake(arm, skeleton, take) -> str:
+    """Save ``take`` as BVH and rebuild the character playing it (the Motion panel's Apply:
+    garments get per-frame corrections); returns the report's tail."""
+    from avatar.blender import character
+    from avatar.errors import AvatarError
+    from avatar.io import bvh
+
+    from . import live as live_props
+
+    if not character.recipe_of(arm).get("clothes"):
+        return "; nothing worn, no garments to bake"
+    path = _take_path(arm.name)
+    try:
+        bvh.save(path, skeleton, take)
+        motion = {"path": path, "frames": None, "fps": None, "in_place": False}
+        built, _ = character.apply_motion(arm, motion)
+    except (AvatarError, OSError) as exc:
+        return f"; garments not baked: {exc}"
+    live_props.sync_from_recipe(built.root)
+    return f"; garments baked (take saved as {path})"
+
+
+def _take_path(name: str) -> str:
+    """A new BVH path for a take: mocap_takes/ beside the .blend file, else in the
+    system's temporary folder (an unsaved file has no folder of its own)."""
+    import os
+    import tempfile
+
+    folder = bpy.path.abspath("//mocap_takes") if bpy.data.filepath else None
+    folder = folder or os.path.join(tempfile.gettempdir(), "avatar_mocap_takes")
+    os.makedirs(folder, exist_ok=True)
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    base = bpy.path.clean_name(name)
+    path = os.path.join(folder, f"{base}-{stamp}.bvh")
+    count = 1
+    while os.path.exists(path):
+        count += 1
+        path = os.path.join(folder, f"{base}-{stamp}-{count}.bvh")
+    return path
+
+
 def _redraw():
     wm = bpy.context.window_manager
     for window in wm.windows if wm is not None else ():
@@ -225,10 +279,10 @@ def _redraw():
 
 
 def release():
-    """On unregister: stop the session (the take is still written)."""
+    """On unregister: stop the session (the take is still keyed; garments not baked)."""
     if _LIVE is not None:
         try:
-            stop("Mocap stopped: the add-on was disabled")
+            stop("Mocap stopped: the add-on was disabled", bake=False)
         except Exception:  # noqa: BLE001 - unregistering must go on
             log.exception("Avatar mocap: stopping on unregister failed")
     if bpy.app.timers.is_registered(tick):
@@ -301,7 +355,9 @@ class AVATAR_PT_mocap(bpy.types.Panel):
         if settings.source == "BVH":
             column.prop(settings, "bvh_header")
         column.prop(settings, "smoothing", slider=True)
-        layout.prop(settings, "record", icon="REC")
+        row = layout.row(align=True)
+        row.prop(settings, "record", icon="REC")
+        row.prop(settings, "bake_garments", icon="MOD_CLOTH")
         row = layout.row(align=True)
         row.scale_y = 1.3
         if _LIVE is None:

@@ -158,6 +158,21 @@ def _heads(arm, *names):
     return [(m @ np.array([*arm.pose.bones[n].head, 1.0]))[:3] for n in names]
 
 
+def _body_vertices(root):
+    """(V, 3) the body's skin as the scene shows it (deformed by the armature)."""
+    import bpy
+
+    from avatar.blender import live
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = live.part_objects(root)["body"].evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    evaluated.to_mesh_clear()
+    return co.reshape(-1, 3)
+
+
 def _angle(a, b) -> float:
     c = np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b))
     return math.degrees(math.acos(min(max(c, -1.0), 1.0)))
@@ -206,9 +221,11 @@ def test_an_independent_vmc_sender_drives_the_pose_bones(human, session_guard):
     try:
         assert _tick_until(lambda: _matches(human, names, *straight))
         shoulder, elbow, wrist = _heads(human, "upperarm01.L", "lowerarm01.L", "wrist.L")
+        skin = _body_vertices(human)
         sender.frame = _frame(lower=BEND)
         assert _tick_until(lambda: _matches(human, names, *bent))
         shoulder2, elbow2, wrist2 = _heads(human, "upperarm01.L", "lowerarm01.L", "wrist.L")
+        skin2 = _body_vertices(human)
     finally:
         sender.stop()
     # Blender's own evaluation of the pose, against the spec (not the library):
@@ -222,7 +239,12 @@ def test_an_independent_vmc_sender_drives_the_pose_bones(human, session_guard):
     assert after[1] / np.linalg.norm(after) < -0.99
     (hips,) = _heads(human, "root")
     np.testing.assert_allclose(hips, [0.0, -0.2, 0.95], atol=1e-4)
-    # the body mesh follows (the armature deforms it in the evaluated scene)
+    # the skin follows (the armature deforms it in the evaluated scene): the left hand
+    # swings forward, the rest of the body stays
+    moved = np.linalg.norm(skin2 - skin, axis=1)
+    assert moved.max() > 0.3 and np.median(moved) < 1e-4
+    hand = moved > 0.1
+    assert np.all(skin2[hand, 0] > 0.1) and np.mean(skin2[hand, 1] - skin[hand, 1]) < -0.1
     stats = panel._LIVE.session.stats()
     assert stats.frames >= 2 and stats.dropped_total == 0
     line = panel.stop()
@@ -429,3 +451,42 @@ def test_stop_and_release_free_the_port_and_the_timer(human, session_guard):
     # and the port can be listened on again by a new session
     assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
     assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
+
+
+def test_bake_garments_rebuilds_the_character_playing_the_take(human, session_guard, tmp_path):
+    """Record with Bake Garments on a dressed character: Stop saves the take as BVH and
+    applies it as the Motion panel does (the garments get per-frame corrections)."""
+    import json
+
+    import bpy
+
+    from avatar.blender import action as action_bridge
+    from avatar.blender import live
+
+    panel = _panel()
+    assert bpy.ops.avatar.wear(name="tshirt") == {"FINISHED"}
+    name = human.name
+    port = _free_port()
+    _configure(bpy.context.scene, port, record=True)
+    bpy.context.scene.avatar_mocap.bake_garments = True
+    try:
+        assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
+        count = 8
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            for i in range(count):
+                half = math.radians(10.0 * i) / 2
+                frame = _frame(lower=[0.0, math.sin(half), 0.0, math.cos(half)], t=i / 30)
+                sock.sendto(_bundle(*frame), ("127.0.0.1", port))
+                time.sleep(0.003)
+        assert _tick_until(lambda: len(panel._LIVE.session.take) == count)
+        assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
+    finally:
+        bpy.context.scene.avatar_mocap.bake_garments = False
+    assert "garments baked" in panel._MESSAGE[0], panel._MESSAGE[0]
+    root = bpy.data.objects[name]
+    motion = json.loads(root["avatar_motion"])
+    assert motion["path"].endswith(".bvh")
+    curves = action_bridge.action_curves(root.animation_data.action)
+    assert {len(c.keyframe_points) for c in curves} == {count}
+    tshirt = live.part_objects(root)["tshirt"]
+    assert tshirt.data.shape_keys is not None  # the per-frame corrections
