@@ -250,8 +250,15 @@ def build_wheel(folder: Path) -> Path:
     the target's wheels travel beside it)."""
     if folder.exists():
         shutil.rmtree(folder)
-    folder.mkdir(parents=True)
-    _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", folder, ROOT)
+    # Built from a copy: setuptools writes build/ and *.egg-info into the tree it builds,
+    # which races with anything else building or importing this checkout.
+    source = folder / "source"
+    skip = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")
+    shutil.copytree(ROOT / "src", source / "src", ignore=skip)
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        if (ROOT / name).is_file():
+            shutil.copy2(ROOT / name, source / name)
+    _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", folder, source)
     wheels = sorted(folder.glob("avatar-*.whl"))
     if not wheels:
         raise BuildError(f"pip wheel produced no avatar wheel in {folder}")

@@ -8,12 +8,12 @@ wear, error reports, Apply with slotted or legacy actions, unregister).
   on PYTHONPATH, a private HOME, no AVATAR_* variables): it makes a dressed human, writes it
   as GLB, and its panels' UILayout calls exist in that Blender. In this venv's bpy 5.0.1, in
   pip bpy 4.2 LTS (no slotted actions) from the venv named by ``AVATAR_BPY42_PYTHON``
-  (default /tmp/bpy42/bin/python: ``python3.11 -m venv /tmp/bpy42 && /tmp/bpy42/bin/pip
+  (default .cache/bpy42 or /tmp/bpy42: ``python3.11 -m venv /tmp/bpy42 && /tmp/bpy42/bin/pip
   install bpy==4.2.0``), in pip bpy 4.4 (slotted actions without
   ``anim_utils.action_ensure_channelbag_for_slot``) from ``AVATAR_BPY44_PYTHON`` (default
-  /tmp/bpy44/bin/python), and in pip bpy 5.1+ on Python 3.13 from ``AVATAR_BPY5X_PYTHON``
-  (default /tmp/bpy52/bin/python: ``python3.13 -m venv /tmp/bpy52 && /tmp/bpy52/bin/pip
-  install bpy==5.2.*``), with the Python 3.13 zip;
+  .cache/bpy44 or /tmp/bpy44), and in pip bpy 5.1+ on Python 3.13 from
+  ``AVATAR_BPY5X_PYTHON`` (default .cache/bpy52 or /tmp/bpy52: ``python3.13 -m venv
+  /tmp/bpy52 && /tmp/bpy52/bin/pip install 'bpy>=5.1'``), with the Python 3.13 zip;
 - this venv's bpy with the checkout's zip (``--no-wheel``) and pygltflib made unimportable:
   creating, dressing and animating never import it (only exports do).
 Each is skipped cleanly when its interpreter is absent. Zips are built once per session;
@@ -34,9 +34,22 @@ from test_extension import FIXTURES, ROOT, load_build_script
 
 SMOKE = Path(__file__).with_name("extension_smoke.py")
 WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
-BPY42 = os.environ.get("AVATAR_BPY42_PYTHON", "/tmp/bpy42/bin/python")
-BPY44 = os.environ.get("AVATAR_BPY44_PYTHON", "/tmp/bpy44/bin/python")
-BPY5X = os.environ.get("AVATAR_BPY5X_PYTHON", "/tmp/bpy52/bin/python")
+
+
+def _interpreter(variable: str, venv: str) -> str:
+    """``$variable``, else the venv ``venv`` made by scripts/setup.sh (.cache/) or by hand
+    (/tmp/), else a path that does not exist (the test skips)."""
+    if os.environ.get(variable):
+        return os.environ[variable]
+    for folder in (ROOT / ".cache" / venv, Path("/tmp") / venv):
+        if (folder / "bin" / "python").is_file():
+            return str(folder / "bin" / "python")
+    return f"/tmp/{venv}/bin/python"
+
+
+BPY42 = _interpreter("AVATAR_BPY42_PYTHON", "bpy42")
+BPY44 = _interpreter("AVATAR_BPY44_PYTHON", "bpy44")
+BPY5X = _interpreter("AVATAR_BPY5X_PYTHON", "bpy52")
 
 
 @pytest.fixture(scope="session")
