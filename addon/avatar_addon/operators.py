@@ -444,25 +444,6 @@ class AVATAR_OT_toggle_garment(_DressOperator, bpy.types.Operator):
         return _dress(self, context, entry, entry not in _worn(root))
 
 
-class AVATAR_OT_apply_motion(_OnCharacter, bpy.types.Operator):
-    """Retarget the BVH clip onto the active character and play it"""
-
-    bl_idname = "avatar.apply_motion"
-    bl_label = "Apply"
-
-    def execute(self, context):
-        motion = context.scene.avatar.motion()
-        obj = context.object
-
-        def apply():  # the character is rebuilt (garments get per-frame shape keys)
-            built, summary = _character().apply_motion(obj, motion)
-            _select(context, built)
-            live.sync_from_recipe(built.root)
-            return summary
-
-        return _call(self, apply)
-
-
 class AVATAR_OT_bind_garment(bpy.types.Operator):
     """Save the selected mesh, modelled on an Avatar character, as a garment that fits every body"""
 
@@ -555,5 +536,4 @@ CLASSES = (
     AVATAR_OT_take_off,
     AVATAR_OT_toggle_garment,
     AVATAR_OT_bind_garment,
-    AVATAR_OT_apply_motion,
-)
+)  # Motion operators: panel_motion.py

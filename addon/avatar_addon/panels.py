@@ -1,4 +1,4 @@
-"""Sidebar panels (View3D > Sidebar > Avatar): Body, Dress, Motion.
+"""Sidebar panels (View3D > Sidebar > Avatar): Body, Dress (Motion: ``panel_motion.py``).
 
 The Body panel shows the active character's own properties (``object.avatar``): moving a
 slider changes that character at once. With no character active it offers Create.
@@ -167,28 +167,4 @@ class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
         layout.operator("avatar.bind_garment", icon="MOD_CLOTH")
 
 
-class AVATAR_PT_motion(_AvatarPanel, bpy.types.Panel):
-    bl_label = "Motion"
-    bl_idname = "AVATAR_PT_motion"
-    bl_order = 2  # feature panels (panel_*.py) follow: 3 and up
-
-    def draw(self, context):
-        settings = context.scene.avatar
-        layout = self.layout
-        layout.prop(settings, "bvh_path")
-        row = layout.row(align=True)
-        row.prop(settings, "frame_start")
-        row.prop(settings, "frame_end")
-        layout.prop(settings, "fps")
-        layout.prop(settings, "in_place")
-        layout.operator("avatar.apply_motion", icon="PLAY")
-        root = root_of(context.object)
-        report = root.get("avatar_motion_report") if root is not None else None
-        if report:
-            box = layout.box()
-            box.label(text="Retarget report", icon="INFO")
-            for line in str(report).splitlines()[:14]:
-                box.label(text=line)
-
-
-CLASSES = (AVATAR_PT_body, AVATAR_PT_dress, AVATAR_PT_motion)
+CLASSES = (AVATAR_PT_body, AVATAR_PT_dress)  # Motion: panel_motion.py

@@ -128,7 +128,8 @@ def _presets(self, context):
 
 class AvatarSettings(bpy.types.PropertyGroup):
     """The panels' options (``scene.avatar``): what Create makes, the Dress panel's library
-    and filters, the Motion panel's clip, measurement targets, randomise, presets."""
+    and filters, measurement targets, randomise, presets (the Motion panel's options are
+    ``scene.avatar_motion``, in panel_motion.py)."""
 
     __annotations__ = {
         "rig": EnumProperty(name="Rig", items=[(r, r.replace("_", " ").title(), "") for r in RIGS]),
@@ -147,18 +148,6 @@ class AvatarSettings(bpy.types.PropertyGroup):
         "garment_index": IntProperty(default=0),
         "garment_search": StringProperty(name="Search", options={"TEXTEDIT_UPDATE"}),
         "category": EnumProperty(name="Category", items=_categories),
-        "bvh_path": StringProperty(name="BVH", subtype="FILE_PATH"),
-        "frame_start": IntProperty(
-            name="Start", min=0, default=0,
-            description="First source frame, 0-based (as the CLI's --frames A:B)",
-        ),
-        "frame_end": IntProperty(
-            name="Stop", min=0, default=0,
-            description="Source frame to stop before (0 = to the end of the clip)",
-        ),
-        "fps": FloatProperty(name="FPS", min=0.0, default=0.0,
-                             description="Resample to this rate (0 = the clip's own)"),
-        "in_place": BoolProperty(name="In place", default=False),
         "target_height": FloatProperty(name="Height", min=0.0, max=250.0, default=0.0,
                                        description="cm (0: keep)"),
         "target_chest": FloatProperty(name="Chest", min=0.0, max=200.0, default=0.0,
@@ -172,14 +161,6 @@ class AvatarSettings(bpy.types.PropertyGroup):
                                   description="Draw plausible bodies (off: anything in range)"),
         "preset": EnumProperty(name="Preset", items=_presets),
     }  # fmt: skip
-
-    def motion(self) -> dict:
-        """The Motion panel as the spec ``avatar.blender.character`` takes."""
-        frames = None
-        if self.frame_start or self.frame_end:
-            frames = [self.frame_start, self.frame_end or None]  # a Python slice, A:B
-        return {"path": bpy.path.abspath(self.bvh_path) if self.bvh_path else "",
-                "frames": frames, "fps": self.fps or None, "in_place": self.in_place}  # fmt: skip
 
     def measurements(self) -> dict:
         """The measurement targets set (metres)."""

@@ -250,7 +250,7 @@ def test_errors_are_reports_and_change_nothing(human, tmp_path):
         bpy.ops.avatar.wear(name="tshrt")
     with pytest.raises(RuntimeError, match="no such garment file"):
         bpy.ops.avatar.wear(name=str(tmp_path / "missing.mhclo"))
-    settings = bpy.context.scene.avatar
+    settings = bpy.context.scene.avatar_motion
     settings.bvh_path = str(tmp_path / "missing.bvh")
     with pytest.raises(RuntimeError, match="no such BVH file"):
         bpy.ops.avatar.apply_motion()
@@ -280,7 +280,7 @@ def test_apply_motion_on_a_dressed_human_keeps_a_report(human):
 
     bpy.ops.avatar.wear(name="tshirt")
     name = human.name
-    settings = bpy.context.scene.avatar
+    settings = bpy.context.scene.avatar_motion
     settings.bvh_path, settings.frame_end = str(WALK), 12
     assert bpy.ops.avatar.apply_motion() == {"FINISHED"}
     root = bpy.context.view_layer.objects.active

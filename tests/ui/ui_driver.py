@@ -66,8 +66,8 @@ def serve():
             with bpy.context.temp_override(window=window, area=area):
                 bpy.ops.ed.undo()
         if name == "request-bvh":
-            bpy.context.scene.avatar.bvh_path = os.environ.get("AVATAR_UI_BVH", "")
-            bpy.context.scene.avatar.frame_end = 30
+            bpy.context.scene.avatar_motion.bvh_path = os.environ.get("AVATAR_UI_BVH", "")
+            bpy.context.scene.avatar_motion.frame_end = 30
     return 0.25
 
 

@@ -37,12 +37,14 @@ from avatar.clothes import binder
 from avatar.clothes import library as clothes_library
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
+from avatar.motion import gait, report_card
 from avatar.motion.retarget import RetargetReport
 from avatar.rig.skeleton import Animation
 
 RECIPE_KEY = live.RECIPE_KEY
 MOTION_KEY = "avatar_motion"  # the Motion panel's spec: {"path", "frames", "fps", "in_place"}
 REPORT_KEY = "avatar_motion_report"  # the last retarget's summary (shown in the panel)
+CARD_KEY = "avatar_motion_card"  # its numbers as JSON (``avatar.motion.report_card.card``)
 DEFAULT_LOOK = ("hair-short", "eyebrows", "eyelashes")  # what a new human wears
 
 
@@ -122,7 +124,9 @@ def apply_motion(
     """Retarget a BVH clip onto the character ``obj`` belongs to and rebuild it playing it.
 
     motion: {"path": BVH file, "frames": [start, stop] (see ``load_motion``) or None,
-    "fps": resample rate or None, "in_place": bool}. Stored on the character, so later
+    "fps": resample rate or None, "in_place": bool, optionally "bone_map": {canonical:
+    [clip bone names]} and "match_names": bool}, or {"walk": {"speed": m/s, "steps": n},
+    "fps": rate} for the built-in walk. Stored on the character, so later
     updates re-apply it. The character is rebuilt, not just given an action, because its
     garments get one corrective shape key per frame (``avatar.export.character``); the new
     one is built before the old one goes, so a failure leaves the character as it was.
@@ -162,6 +166,7 @@ def _rebuild(root: bpy.types.Object, recipe, motion):
     if motion:
         built.root[MOTION_KEY] = json.dumps(dict(motion))
         built.root[REPORT_KEY] = report.summary() if report is not None else ""
+        built.root[CARD_KEY] = json.dumps(report_card.card(report)) if report is not None else ""
     return built, animation
 
 
@@ -180,14 +185,26 @@ def _swap(root: bpy.types.Object, build: Callable[[], stage.CharacterObjects]):
     return built
 
 
-def load_motion(motion: Mapping[str, object], human: Human) -> tuple[Animation, RetargetReport]:
+def load_motion(
+    motion: Mapping[str, object], human: Human
+) -> tuple[Animation, RetargetReport | None]:
     """The Animation of a Motion-panel spec, retargeted onto ``human`` and settled on its
-    skin (planted feet on the floor), and the retarget's quality report. Raises AvatarError
-    for a missing, unreadable or empty clip.
+    skin (planted feet on the floor), and the retarget's quality report (None for the
+    built-in walk). Raises AvatarError for a missing, unreadable or empty clip, or a bad
+    bone map.
 
     motion["frames"]: [start, stop] source frames as the CLI's ``--frames A:B`` (0-based,
     stop exclusive, None = to the end), or None for the whole clip.
+    motion["bone_map"]: {canonical: [clip bone names]} (a mapping edited in the Motion
+    panel) or None for the automatic one; motion["match_names"]: also drive same-named
+    bones (default True).
     """
+    walk = motion.get("walk")
+    if isinstance(walk, Mapping):
+        animation = gait.walk(human.skeleton, float(walk.get("speed", 1.3)),
+                              int(walk.get("steps", 8)), float(motion.get("fps") or 30.0),
+                              body=human.body)  # fmt: skip
+        return animation, None
     frames = motion.get("frames")
     path = Path(str(motion.get("path") or ""))
     if not str(motion.get("path") or "").strip():
@@ -205,6 +222,8 @@ def load_motion(motion: Mapping[str, object], human: Human) -> tuple[Animation, 
         frames=slice(*frames) if frames else None,
         fps=motion.get("fps"),
         in_place=bool(motion.get("in_place")),
+        source_map=motion.get("bone_map") or "auto",
+        match_names=bool(motion.get("match_names", True)),
     )
     if animation.frames == 0:
         raise AvatarError(f"{path.name}: no frames in {frames[0]}:{frames[1]}")

@@ -122,6 +122,14 @@ def _parse(text: str, path: str) -> dict:
     return data
 
 
+def _checked(table: dict) -> dict[str, list[str]]:
+    """A {canonical: names} table checked as a file's would be (ParameterError if not)."""
+    try:
+        return _parse(json.dumps({"name": "custom", "bones": table}), "bone map")["bones"]
+    except FormatError as exc:
+        raise ParameterError(str(exc)) from None
+
+
 def load(path: str | os.PathLike[str]) -> dict[str, list[str]]:
     """A user's bone map file -> {canonical: candidate names}."""
     return _parse(Path(path).read_text(encoding="utf-8"), str(path))["bones"]
@@ -152,12 +160,16 @@ def _resolve(index: dict[str, int], table: Mapping[str, Sequence[str]], name: st
     return BoneMap(name, bones, missing)
 
 
+Convention = str | os.PathLike[str] | Mapping[str, Sequence[str]]
+"""A convention name, a bone map file, "topology", "auto", or a {canonical: names} table."""
+
+
 def detect(
     skeleton: Skeleton,
-    convention: str | os.PathLike[str] = "auto",
+    convention: Convention = "auto",
     heads: np.ndarray | None = None,
 ) -> BoneMap:
-    """The bone map of a skeleton: by convention name, user file, "topology" or "auto".
+    """The bone map of a skeleton: by convention name, user file, table, "topology" or "auto".
 
     "auto" scores every shipped convention by the body bones it finds and keeps the best;
     when that lacks body bones, the hierarchy and geometry fill them in (see
@@ -166,6 +178,8 @@ def detect(
     skeleton without recognisable hips.
     """
     known = _shipped()
+    if isinstance(convention, Mapping):  # a table, e.g. a mapping edited in the extension
+        return apply(skeleton, _checked(dict(convention)), "custom")
     if convention == "topology":
         return _by_topology(skeleton, heads)
     if convention != "auto":

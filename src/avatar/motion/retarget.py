@@ -22,7 +22,6 @@ driven bones or segment ends are evaluated.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -105,8 +104,8 @@ def retarget(
     target_skeleton: Skeleton,
     *,
     body: Body | None = None,
-    source_map: str | os.PathLike[str] = "auto",
-    target_map: str | os.PathLike[str] = "auto",
+    source_map: bonemap.Convention = "auto",
+    target_map: bonemap.Convention = "auto",
     frames: slice | None = None,
     fps: float | None = None,
     in_place: bool = False,
@@ -122,7 +121,8 @@ def retarget(
     body: the shaped body on ``target_skeleton`` (``Human.body``), or None: the result is
         then settled on its skin (``floor.settle_body``: planted feet touch the floor, no
         vertex under it; ``RetargetReport.floor`` says how it meets it).
-    source_map/target_map: convention name, bone map JSON path, or "auto".
+    source_map/target_map: convention name, bone map JSON path, {canonical: [names]}
+        table (``bonemap.detect``), or "auto".
     frames: source frames to keep (slice, applied before resampling); fps: output rate.
     in_place: remove horizontal root motion. fix_feet: keep contacts planted, soles on the
         floor and out of it (leg IK, ``contacts.plant`` and ``contacts.lift``).
