@@ -36,6 +36,7 @@ import shutil
 import subprocess
 import sys
 import tomllib
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,6 +59,13 @@ BUNDLED = ("scipy", "pillow", "pykdtree", "tqdm", "pygltflib")
 OPTIONAL = frozenset({"pykdtree"})
 # In Blender's own Python already (and Blender's copy must win: bpy is built against it).
 BLENDER_SHIPS = frozenset({"numpy"})
+
+# The oldest numpy a Blender on each Python ships: Blender 4.2 LTS has numpy 1.24.3 (4.4-5.0
+# 1.26.4); pip bpy 5.1+ (Python 3.13) requires numpy >= 2.2. Every bundled wheel must accept it.
+BLENDER_NUMPY = {"3.11": "1.24.3", "3.13": "2.2.0"}
+# Versions other than the ones installed here, where those reject Blender's numpy: SciPy 1.16+
+# needs numpy >= 1.25.2; 1.15.3 is the newest that imports in Blender 4.2.
+PINS = {"3.11": {"scipy": "1.15.3"}}
 
 PYTHONS = {  # Blender's Python -> (blender_version_min, blender_version_max or None)
     "3.11": ("4.2.0", "5.1.0"),
@@ -273,9 +281,10 @@ def bundled_requirements(
     """{canonical name: version} of every wheel the zip for ``target`` carries besides the
     avatar library and the assets: ``BUNDLED`` and what they require on that target (its
     environment markers), minus what Blender ships. Versions are those installed here
-    (``version``); a requirement not installed here (colorama, Windows only) maps to None:
-    the newest wheel on the index."""
+    (``version``) unless ``PINS`` names another for the target's Python; a requirement not
+    installed here (colorama, Windows only) maps to None: the newest wheel on the index."""
     environment = target.marker_environment()
+    pins = PINS.get(target.python, {})
     found: dict[str, str | None] = {}
     todo = list(BUNDLED)
     while todo:
@@ -283,7 +292,7 @@ def bundled_requirements(
         if name in found or name in BLENDER_SHIPS:
             continue
         try:
-            found[name] = version(name)
+            found[name] = pins.get(name) or version(name)
         except importlib.metadata.PackageNotFoundError:
             found[name] = None
             continue
@@ -304,13 +313,44 @@ def target_wheels(target: Target, cache: Path, *, offline: bool = False) -> list
     wheels = []
     for name, version in wanted.items():
         try:
-            wheels.append(cached_wheel(name, version, target, cache, offline=offline))
+            wheel = cached_wheel(name, version, target, cache, offline=offline)
         except BuildError:
             if name not in OPTIONAL:
                 raise
             log.warning("no %s wheel for %s: the clothes code uses SciPy's k-d tree there",
                         name, target.name)  # fmt: skip
+            continue
+        check_blender_numpy(wheel, target)
+        wheels.append(wheel)
     return wheels
+
+
+def wheel_requirements(wheel: Path) -> list[Requirement]:
+    """The ``Requires-Dist`` lines of a wheel's METADATA."""
+    with zipfile.ZipFile(wheel) as archive:
+        (metadata,) = [n for n in archive.namelist()
+                       if n.count("/") == 1 and n.endswith(".dist-info/METADATA")]  # fmt: skip
+        text = archive.read(metadata).decode("utf-8", "replace")
+    return [Requirement(line.split(":", 1)[1].strip()) for line in text.splitlines()
+            if line.startswith("Requires-Dist:")]  # fmt: skip
+
+
+def check_blender_numpy(wheel: Path, target: Target) -> None:
+    """Raise BuildError when ``wheel`` requires a numpy the oldest Blender on the target's
+    Python does not ship (BLENDER_NUMPY): it would not import there."""
+    shipped = BLENDER_NUMPY[target.python]
+    environment = target.marker_environment()
+    for requirement in wheel_requirements(wheel):
+        if canonicalize_name(requirement.name) != "numpy":
+            continue
+        if requirement.marker is not None and not requirement.marker.evaluate(environment):
+            continue
+        if not requirement.specifier.contains(shipped, prereleases=True):
+            raise BuildError(
+                f"{wheel.name} requires numpy{requirement.specifier} but Blender "
+                f"{target.blender_versions[0]} ships numpy {shipped}: pin an older "
+                f"{wheel.name.split('-')[0]} in PINS"
+            )
 
 
 def cached_wheel(name: str, version: str | None, target: Target, cache: Path, *,

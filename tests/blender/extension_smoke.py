@@ -61,7 +61,8 @@ def main() -> int:
     import bpy
     import numpy as np
 
-    print("blender", bpy.app.version_string, "python", sys.version.split()[0])
+    print("blender", bpy.app.version_string, "python", sys.version.split()[0],
+          "numpy", np.__version__)
     install(bpy, args.zip)
     if args.zip_alone:
         check_installed_from(user)

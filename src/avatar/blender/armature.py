@@ -105,12 +105,17 @@ class _edit_mode:
 def _mode_set(obj: bpy.types.Object, mode: str) -> None:
     """``object.mode_set`` on ``obj``, without the depsgraph evaluations ``bpy.ops`` adds
     before and after every call (with a few characters in the scene they cost ~10 ms, far
-    more than the mode switch): the operator is called through the module ``bpy.ops`` wraps
-    (its signature gained the context argument's removal in 4.0), else through ``bpy.ops``."""
+    more than the mode switch): the operator is called through the C function ``bpy.ops``
+    wraps (its signature lost the context argument in 4.0), else (Blender 5.1+ has no such
+    function: ``bpy.ops._op_call`` is gone and its name resolves to an operator submodule)
+    through ``bpy.ops``."""
     with bpy.context.temp_override(active_object=obj, object=obj):
         try:
-            from bpy.ops import _op_call  # the C entry point bpy.ops wraps
+            from _bpy import ops as c_ops  # the C module bpy.ops wraps
         except ImportError:
+            c_ops = None
+        _op_call = getattr(c_ops, "call", None)
+        if not callable(_op_call):
             bpy.ops.object.mode_set(mode=mode)
             return
         if bpy.app.version >= (4, 0):
