@@ -70,7 +70,7 @@ MAKEHUMAN_LOOK = (
 )
 MACRO = "weight"  # the slider both add-ons move
 
-Step = Callable[[int], object]  # does repeat i of a step (its value is ignored)
+Step = Callable[[int], Callable[[], None] | None]  # repeat i -> how to undo it (untimed)
 Runs = list[tuple[float, float]]  # (wall-clock, process CPU) seconds per repeat
 
 
@@ -177,16 +177,21 @@ Times = tuple[Runs, Runs | None]  # Avatar's, MPFB2's (None: not run)
 def _alternate(avatar: Step, mpfb: Step | None, repeat: int) -> Times:
     """Wall-clock and CPU seconds of each side per repeat, after one warm-up; with MPFB2,
     the two run one after the other, the order swapped every repeat. CPU time (all threads
-    of this process) is what other engineers' load on a shared machine disturbs least."""
+    of this process) is what other engineers' load on a shared machine disturbs least.
+    What a timed repeat made is removed after it (untimed); the warm-up's stays, so every
+    timed create adds a human to a scene holding one of each add-on, as a user's second
+    human is added (materials already made), and none slows down as the scene fills."""
     ours: Runs = []
     theirs: Runs = []
     for i in range(repeat + 1):
         sides = [(avatar, ours), (mpfb, theirs)] if mpfb is not None else [(avatar, ours)]
         for step, runs in sides[:: -1 if i % 2 else 1]:
             wall, cpu = time.perf_counter(), time.process_time()
-            step(i)
+            undo = step(i)
             if i:
                 runs.append((time.perf_counter() - wall, time.process_time() - cpu))
+                if undo is not None:
+                    undo()
     return ours, (theirs if mpfb is not None else None)
 
 
@@ -196,21 +201,26 @@ def _value(i: int) -> float:
 
 
 def _avatar_create(clothes: list[str], rigged: bool) -> Step:
-    """``character.create`` (as the Create button; real-time garment fit), each human added
-    next to the others, as a user adds them (they share materials)."""
+    """``character.create`` (as the Create button; real-time garment fit)."""
     from avatar.blender import character
 
-    def step(i: int) -> None:
-        character.create({"params": {}, "clothes": clothes}, rigged=rigged, exact=False)
+    def step(i: int) -> Callable[[], None]:
+        root = character.create({"params": {}, "clothes": clothes}, rigged=rigged,
+                                exact=False).root  # fmt: skip
+        return lambda: character.remove(root)
 
     return step
 
 
 def _mpfb_create(mpfb, assets: list[Path] | None) -> Step:
-    def step(i: int) -> None:
+    """MPFB2's Create (+ rig and each asset's Load when dressed)."""
+    import mpfb_driver
+
+    def step(i: int) -> Callable[[], None]:
         basemesh = mpfb.create()
         if assets is not None:
             mpfb.dress(basemesh, assets)
+        return lambda: mpfb_driver.remove(basemesh)
 
     return step
 
@@ -223,6 +233,7 @@ def _avatar_change(clothes: list[str], rigged: bool) -> Step:
 
     def step(i: int) -> None:
         setattr(root.avatar, MACRO, _value(i))
+        return None
 
     return step
 
@@ -238,6 +249,7 @@ def _mpfb_change(mpfb, assets: list[Path] | None, parts: list[tuple[float, float
         slider, refit = mpfb.change(basemesh, MACRO, _value(i), refit=assets is not None)
         if i:
             parts.append((slider, refit))
+        return None
 
     return step
 

@@ -95,18 +95,22 @@ class Mpfb:
 
 
 def remove(basemesh: bpy.types.Object) -> None:
-    """Delete an MPFB2 human: its root (rig or basemesh), everything under it and their data."""
+    """Delete an MPFB2 human: its root (rig or basemesh), everything under it, and their
+    meshes, armature, materials and images once nothing else uses them."""
     root = basemesh.parent or basemesh
     objects = [root, *root.children_recursive]
     datas = [o.data for o in objects if o.data is not None]
-    materials = [m for d in datas for m in getattr(d, "materials", []) if m is not None]
+    materials = {m for d in datas for m in getattr(d, "materials", []) if m is not None}
+    images = {n.image for m in materials if m.node_tree for n in m.node_tree.nodes
+              if n.type == "TEX_IMAGE" and n.image is not None}  # fmt: skip
     for obj in objects:
         bpy.data.objects.remove(obj)
-    for block in (*datas, *materials):
-        if block.users == 0:
-            pool = {bpy.types.Mesh: bpy.data.meshes, bpy.types.Armature: bpy.data.armatures,
-                    bpy.types.Material: bpy.data.materials}.get(type(block))  # fmt: skip
-            if pool is not None:
+    meshes = [d for d in datas if isinstance(d, bpy.types.Mesh)]
+    armatures = [d for d in datas if isinstance(d, bpy.types.Armature)]
+    for pool, blocks in ((bpy.data.meshes, meshes), (bpy.data.armatures, armatures),
+                         (bpy.data.materials, materials), (bpy.data.images, images)):  # fmt: skip
+        for block in blocks:  # each once, in an order where users drop to 0 before
+            if block.users == 0:
                 pool.remove(block)
 
 
