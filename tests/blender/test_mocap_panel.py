@@ -490,3 +490,89 @@ def test_bake_garments_rebuilds_the_character_playing_the_take(human, session_gu
     assert {len(c.keyframe_points) for c in curves} == {count}
     tshirt = live.part_objects(root)["tshirt"]
     assert tshirt.data.shape_keys is not None  # the per-frame corrections
+
+
+def _serve_lines(lines, delay=0.003):
+    """A one-client TCP server (Axis Neuron's role) sending ``lines``; returns its port."""
+    server = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+
+    def serve():
+        conn, _ = server.accept()
+        with conn:
+            for line in lines:
+                conn.sendall(line.encode() + b"\n")
+                time.sleep(delay)
+            time.sleep(1.0)
+        server.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    return server.getsockname()[1]
+
+
+def test_a_bvh_stream_without_header_drives_the_character_with_the_skeleton_file(
+    human, session_guard
+):
+    """Frame lines only (the server sends no HIERARCHY), the skeleton from the panel's file:
+    every frame arrives and is recorded; a skeleton file that is not there is one line."""
+    import bpy
+
+    walk = test_extension.WALK
+    if not walk.is_file():
+        pytest.skip("fixture BVH clip not found")
+    panel = _panel()
+    settings = bpy.context.scene.avatar_mocap
+    settings.bvh_header = str(walk.with_name("no such file.bvh"))
+    _configure(bpy.context.scene, _serve_lines([]), source="BVH", record=True)
+    with pytest.raises(RuntimeError, match="cannot read the stream's skeleton"):
+        bpy.ops.avatar.mocap_start()
+    lines = walk.read_text().split("MOTION", 1)[1].strip().splitlines()[2:22]
+    settings.bvh_header = str(walk)
+    _configure(bpy.context.scene, _serve_lines(lines), source="BVH", record=True)
+    try:
+        assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
+        assert _tick_until(lambda: len(panel._LIVE.session.take) == len(lines))
+        assert panel._LIVE.session.stats().dropped_total == 0
+        assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
+    finally:
+        settings.bvh_header = ""
+    assert f"{len(lines)} frames" in panel._MESSAGE[0]
+
+
+def test_a_keypoints_stream_drives_the_character(human, session_guard):
+    import bpy
+
+    from avatar.mocap import keypoint_stream, keypoints
+    from avatar.rig.skeleton import Animation
+
+    panel = _panel()
+    port = _free_port()
+    _configure(bpy.context.scene, port, source="KEYPOINTS")
+    bpy.context.scene.avatar_mocap.keypoint_set = "coco17"
+    skeleton = _skeleton(human)
+    rig = keypoints.bind("coco17", skeleton)
+    # the left forearm bent 90 degrees forward at the elbow, as keypoints
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (1, len(skeleton.names), 1))
+    j = skeleton.index("lowerarm01.L")
+    rot[0, j] = [S, S, 0.0, 0.0]
+    points = rig.positions(Animation(rot, np.zeros((1, len(skeleton.names), 3)), 30.0,
+                                     skeleton.names))[0]  # fmt: skip
+    assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
+    names = skeleton.names
+    rest = _pose_bones(human, names)[0].copy()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        for i in range(10):
+            sock.sendto(keypoint_stream.encode(i, points, None, i / 30, "coco17", "avatar"),
+                        ("127.0.0.1", port))  # fmt: skip
+            time.sleep(0.003)
+    assert _tick_until(lambda: panel._LIVE.session.stats().frames >= 1)
+    panel.tick()
+    got = _pose_bones(human, names)[0]
+    assert np.abs(np.sum(got[j] * rest[j])) < 0.99  # the forearm turned
+    # ... to where the keypoints put it: elbow -> wrist along the streamed one
+    elbow, wrist = _heads(human, "lowerarm01.L", "wrist.L")
+    k = rig.keypoints.index
+    assert _angle(wrist - elbow, points[k("left_wrist")] - points[k("left_elbow")]) < 5.0
+    assert panel._LIVE.session.stats().dropped_total == 0
+    assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
