@@ -158,13 +158,19 @@ def start(scene, root) -> str:
 
 
 def _armature(live):
-    """The driven armature: by name, else by the session's tag (renamed), else None."""
-    obj = bpy.data.objects.get(live.armature)
-    if obj is None or obj.get(TAG_KEY) != live.tag:
-        obj = next((o for o in bpy.data.objects if o.get(TAG_KEY) == live.tag), None)
-        if obj is not None:
-            live.armature = obj.name
-    return obj
+    """The driven armature: by name and tag; else by tag (it was renamed); else by name
+    alone (an undo went back past Start and took the tag: put it back); else None."""
+    named = bpy.data.objects.get(live.armature)
+    if named is not None and named.get(TAG_KEY) == live.tag:
+        return named
+    obj = next((o for o in bpy.data.objects if o.get(TAG_KEY) == live.tag), None)
+    if obj is not None:
+        live.armature = obj.name
+        return obj
+    if named is not None and named.type == "ARMATURE" and TAG_KEY not in named.keys():
+        named[TAG_KEY] = live.tag
+        return named
+    return None
 
 
 def tick():
@@ -215,6 +221,8 @@ def stop(message: str | None = None, bake: bool = True) -> str:
             scene = bpy.data.scenes.get(live.scene)
             act = mocap_drive.write_take(arm, take, f"{arm.name} take", scene=scene)
             line += f"; {take.frames} frames at {take.fps:g} fps keyed into '{act.name}'"
+            if mocap_drive.keep_action(live.held_action):
+                line += f" ('{live.held_action}' kept with a fake user)"
             if bake and scene is not None and scene.avatar_mocap.bake_garments:
                 line += _bake(arm, live.session.skeleton, take)
         else:

@@ -402,6 +402,22 @@ def test_no_bvh_server_is_a_one_line_error(human, session_guard):
     assert not _panel().running()
 
 
+def test_a_rename_or_an_undone_tag_keeps_the_session_running(human, session_guard):
+    import bpy
+
+    panel = _panel()
+    _configure(bpy.context.scene, _free_port())
+    assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
+    human.name = "Renamed"
+    assert panel.tick() == pytest.approx(panel.INTERVAL)
+    assert panel._LIVE.armature == "Renamed"
+    del human[panel.TAG_KEY]  # what an undo to before Start does to the tag
+    assert panel.tick() == pytest.approx(panel.INTERVAL)
+    assert human.get(panel.TAG_KEY) == panel._LIVE.tag
+    assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
+    assert panel.TAG_KEY not in human.keys()
+
+
 def test_deleting_the_character_stops_the_timer_cleanly(human, session_guard):
     import bpy
 
@@ -442,6 +458,19 @@ def test_stop_and_release_free_the_port_and_the_timer(human, session_guard):
     assert human.animation_data.action == held  # nothing recorded: the user's action is back
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as again:
         again.bind(("127.0.0.1", port))
+    # a take replaces the user's action on the armature; the old one keeps a fake user
+    bpy.context.scene.avatar_mocap.record = True
+    assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
+    sender = Sender(port, _frame(lower=BEND))
+    sender.start()
+    try:
+        assert _tick_until(lambda: len(panel._LIVE.session.take) > 0)
+    finally:
+        sender.stop()
+    assert bpy.ops.avatar.mocap_stop() == {"FINISHED"}
+    assert human.animation_data.action != held and held.use_fake_user
+    assert "kept with a fake user" in panel._MESSAGE[0]
+    bpy.context.scene.avatar_mocap.record = False
     # release() (the add-on's unregister) stops a running session the same way
     assert bpy.ops.avatar.mocap_start() == {"FINISHED"}
     panel.release()

@@ -6,8 +6,9 @@ pose bones' ``rotation_quaternion`` and ``location``), as two whole-array writes
 (``foreach_set``) over the armature's pose bones; bones the skeleton lacks keep their
 values. A live pose would be overwritten whenever the armature's Action is evaluated, so
 ``hold_action`` detaches it while a stream drives the armature and ``restore_action`` puts
-it back. ``write_take`` keys a recorded take, one key per frame, through
-``avatar.blender.action`` (slotted actions feature-detected).
+it back (or ``keep_action`` keeps it, with a fake user, when a take replaced it).
+``write_take`` keys a recorded take, one key per frame, through ``avatar.blender.action``
+(slotted actions feature-detected).
 
 Nothing here keeps a Blender reference between calls; callers look the armature up by
 name each time (undo and deletion invalidate references).
@@ -83,6 +84,16 @@ def restore_action(armature_obj: bpy.types.Object, name: str | None) -> None:
         slots = [s for s in found.slots if s.target_id_type == "OBJECT"]
         if slots:
             armature_obj.animation_data.action_slot = slots[0]
+
+
+def keep_action(name: str | None) -> bool:
+    """Give the Action ``name`` a fake user if nothing uses it any more (a take replaced it
+    on the armature), so saving the file does not drop it; True when one was given."""
+    found = bpy.data.actions.get(name) if name else None
+    if found is None or found.users > 0:
+        return False
+    found.use_fake_user = True
+    return True
 
 
 def write_take(
