@@ -14,7 +14,7 @@ from pathlib import Path
 from avatar import export
 from avatar.body import measures
 from avatar.body.model import BodyModel
-from avatar.cli import motion, paths
+from avatar.cli import motion, paths, presets
 from avatar.cli.assignments import parse_assignments, parse_measurements
 from avatar.clothes import library
 from avatar.errors import AvatarError
@@ -66,13 +66,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--keep-body", action="store_true",
                    help="keep the whole body under every garment (e.g. for cloth "
                    "simulation)")  # fmt: skip
-    p.add_argument("--max-influences", type=int, choices=(4, 8), default=8,
+    p.add_argument("--preset", choices=sorted(presets.PRESETS), default="full",
+                   help="glTF export budget: full (textures as made, 8 joints per vertex) "
+                   "or game (4 joints, maps at most 1024 px, 2 LODs); the options below "
+                   "override it (default full)")  # fmt: skip
+    p.add_argument("--max-influences", type=int, choices=(4, 8),
                    help="glTF: joints per vertex (4 for three.js and engines that read "
                    "one JOINTS set; default 8)")  # fmt: skip
     p.add_argument("--texture-size", type=int, metavar="PX",
                    help="glTF/OBJ: longest texture side, e.g. 512, 1024, 2048 (default: each "
                    "part's textures sized to its surface)")  # fmt: skip
-    p.add_argument("--lods", type=int, default=0, metavar="N",
+    p.add_argument("--lods", type=int, metavar="N",
                    help="glTF: N decimated levels of the body and garments (<name>_LOD1.., "
                    "each half the triangles of the one before)")  # fmt: skip
     p.add_argument("--expressions", action="store_true",
@@ -94,8 +98,9 @@ def run(args: argparse.Namespace) -> int:
     path = export.save(human, args.output, animation, expressions=args.expressions,
                        hide_covered=_hiding(args), animation_name=name, rest=args.rest,
                        resolve_garments=args.resolve_garments, progress=True,
-                       max_influences=args.max_influences, texture_size=args.texture_size,
-                       lods=args.lods)  # fmt: skip
+                       **presets.export_options(args.preset, max_influences=args.max_influences,
+                                                texture_size=args.texture_size,
+                                                lods=args.lods))  # fmt: skip
     log.info("wrote %s", path)
     if args.render:  # the same parts as the file
         picture = export.render(human, args.render, animation, hide_covered=_hiding(args),

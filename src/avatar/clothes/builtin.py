@@ -25,7 +25,7 @@ from avatar.clothes.authoring import (
 )
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
-from avatar.looks import fabrics, textures
+from avatar.looks import fabrics, facial_hair, textures
 from avatar.material import Material
 
 RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
@@ -240,6 +240,9 @@ SPECS = [
     Spec("eyebrows-blond", "face", face.eyebrows, "hair", "blond hair", 0.0, 5, ("eyebrows", "blond"), False),  # noqa: E501
     Spec("eyebrows-black", "face", face.eyebrows, "hair", "black hair", 0.0, 5, ("eyebrows", "black"), False),  # noqa: E501
     Spec("eyelashes", "face", lambda b: face.eyelashes(b, EYELASH_GROUPS), "hair", "black hair", 0.0, 5, ("eyelashes",), False),  # noqa: E501
+    Spec("beard-short", "beard", face.beard, "hair", "dark brown", 0.0, 6, ("beard", "facial hair", "men"), look=facial_hair.beard_material),  # noqa: E501
+    Spec("moustache", "beard", face.moustache, "hair", "dark brown", 0.0, 6, ("moustache", "mustache", "facial hair", "men"), look=facial_hair.beard_material),  # noqa: E501
+    Spec("stubble", "beard", face.stubble, "hair", "black hair", 0.0, 4, ("stubble", "facial hair", "men"), False, look=facial_hair.stubble_material),  # noqa: E501
 ]  # fmt: skip
 
 BY_NAME = {s.name: s for s in SPECS}

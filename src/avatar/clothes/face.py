@@ -1,12 +1,15 @@
 """Face pieces: eyebrows painted on patches of the brow skin, eyelashes on the base mesh's
-lash helper strips (textures in ``textures``: ``brow_alpha``, ``lash_alpha``)."""
+lash helper strips (textures in ``textures``: ``brow_alpha``, ``lash_alpha``), facial hair
+(a short beard and a moustache as strand cards, stubble as a tiled layer on the skin), and
+the UVs of the teeth over their teeth-and-gums texture."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, single_references
-from avatar.clothes.hair import per_corner
+from avatar.clothes.hair import around, cards_on, head_frame, per_corner
 from avatar.geometry.shell import boundary_edges
 from avatar.mesh import Mesh
 
@@ -121,3 +124,121 @@ def _arch_length(points: np.ndarray, uv: np.ndarray) -> np.ndarray:
     gum = np.stack([points[(uv[:, 0] == c) & (uv[:, 1] == 0)].mean(axis=0) for c in columns])
     length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(gum, axis=0), axis=1))])
     return np.interp(uv[:, 0], columns, length / length[-1]).astype(np.float32)
+
+
+# ---------------------------------------------------------------------------- facial hair
+
+
+def mouth_frame(body: AuthoringBody) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """(skull centre (3,), mouth (3,): the upper teeth's centre, eye height z, chin z: the
+    lowest skin of the face's front) of the authoring body."""
+    centre, eye_z = head_frame(body)
+    mouth = body.centre("helper-upper-teeth")
+    skin = body.vertices[:BODY_VERTICES]
+    head = skin[(body.part[:BODY_VERTICES] == "head") & (skin[:, 1] < centre[1] - 0.05)]
+    return centre, mouth, eye_z, float(head[:, 2].min())
+
+
+# Where a full beard grows, by the direction around the head (degrees from the front): its
+# upper edge above the mouth (m): the moustache under the nose, the cheek line, then up to
+# the sideburns in front of the ears.
+CHEEK_DEG = (0, 12, 20, 35, 55, 70, 80, 86)
+CHEEK_M = (0.018, 0.018, 0.026, 0.03, 0.034, 0.045, 0.05, 0.05)
+
+
+def facial_hair_mask(body: AuthoringBody, part: str) -> np.ndarray:
+    """(F,) bool skin faces where facial hair grows: ``part`` "beard" (a full beard: chin,
+    jaw, cheeks below the cheek line, sideburns, moustache, the throat under the chin down
+    3 cm) or "moustache" (the upper lip under the nose). Lips and the mouth's lining are
+    left bare (MakeHuman's lips and inside-mouth region masks, by the skin's UVs)."""
+    centre, mouth, eye_z, chin_z = mouth_frame(body)
+    c = body.vertices[body.skin_faces].mean(axis=1)
+    turn = around(c, centre)
+    rel_z = c[:, 2] - mouth[2]
+    front = c[:, 1] < centre[1] - 0.01  # ahead of the ears
+    bare = _region(body, "lips", 0.25) | _region(body, "inside-mouth", 0.1)
+    # Skin facing away from the head's axis, or down (under the chin): not the mouth's
+    # lining, which faces in.
+    normal = body.skin_normals[body.skin_faces].mean(axis=1)
+    radial = (c - centre)[:, :2]
+    outside = (np.einsum("fd,fd->f", normal[:, :2], radial) > 0) | (normal[:, 2] < -0.5)
+    if part == "moustache":
+        lip = (np.abs(c[:, 0]) < 0.025) & (rel_z > -0.002) & (rel_z < 0.018)
+        return lip & front & ~bare & outside & (c[:, 1] < mouth[1] - 0.01)
+    top = np.interp(turn, CHEEK_DEG, CHEEK_M)
+    # Under the chin to the top of the throat, not down the neck.
+    beard = (rel_z < top) & (c[:, 2] > chin_z - 0.018) & (turn < 88)
+    return beard & front & ~bare & outside & (c[:, 2] < eye_z)
+
+
+def _region(body: AuthoringBody, name: str, level: float) -> np.ndarray:
+    """(F,) bool skin faces whose UV centre lies in a MakeHuman skin region mask."""
+    from avatar.looks.skin import region_masks
+
+    mask = region_masks(256)[name]
+    base = body.base
+    assert base.uvs is not None and base.face_uvs is not None, "the base mesh has UVs"
+    uv = base.uvs[base.face_uvs[base.face_groups["body"]]].mean(axis=1)
+    rows = np.clip(((1 - uv[:, 1]) * 256).astype(int), 0, 255)
+    cols = np.clip((uv[:, 0] * 256).astype(int), 0, 255)
+    return mask[rows, cols] > level
+
+
+def _beard_flow(centre: np.ndarray):
+    """Beard hair grows down the face and, under the chin, back down the throat; the
+    moustache's down and out from the middle of the lip."""
+
+    def flow(points: np.ndarray) -> np.ndarray:
+        d = np.zeros_like(points)
+        d[:, 2] = -1.0
+        d[:, 1] = 0.6 * (points[:, 1] < centre[1] - 0.06)  # under the chin: towards the neck
+        d[:, 0] = 0.25 * np.sign(points[:, 0]) * (np.abs(points[:, 0]) < 0.03)
+        return d
+
+    return flow
+
+
+def beard(body: AuthoringBody, count: int = 2400, length=(0.008, 0.015)) -> Piece:
+    """A short full beard: narrow strand cards rooted over ``facial_hair_mask(body,
+    "beard")``, combed down the face, about a centimetre long, lying close to the skin and
+    thinning out at its edges. The hair above the mouth (the moustache) and the rest are
+    bound apart: one rides the upper lip, the other the jaw, so opening the mouth parts
+    them."""
+    centre, mouth, *_ = mouth_frame(body)
+    keep = facial_hair_mask(body, "beard")
+    c = body.vertices[body.skin_faces].mean(axis=1)
+    upper = (c[:, 2] > mouth[2] - 0.004) & (np.abs(c[:, 0]) < 0.035)
+    share = (keep & upper).sum() / keep.sum()
+    flow, lift = _beard_flow(centre), (0.001, 0.003)
+    return join([
+        cards_on(body, keep & upper, flow, int(count * share), length, 0.0035, lift, fade=0.006),
+        cards_on(body, keep & ~upper, flow, count - int(count * share), length, 0.0035, lift,
+                 seed=2, fade=0.012),
+    ])  # fmt: skip
+
+
+def moustache(body: AuthoringBody, count: int = 420) -> Piece:
+    """A moustache: narrow strand cards over the upper lip, combed down and out over it."""
+    centre, *_ = mouth_frame(body)
+    keep = facial_hair_mask(body, "moustache")
+    return cards_on(body, keep, _beard_flow(centre), count, (0.008, 0.013), 0.0035,
+                    (0.001, 0.0025), seed=1, fade=0.005)  # fmt: skip
+
+
+STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble texture covers
+
+
+def stubble(body: AuthoringBody) -> Piece:
+    """Stubble: the beard's skin lifted half a millimetre, with UVs tiling the stubble
+    texture (``looks.facial_hair.stubble_material``) every ``STUBBLE_TILE`` m, projected
+    from the front and the sides so the short hairs keep their size round the jaw."""
+    faces = body.skin_faces
+    mesh = cut(body, faces, facial_hair_mask(body, "beard"), 0.0005, relax=4)
+    centre, *_ = mouth_frame(body)
+    p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, 4, 3)
+    rel = p - centre
+    angle = np.arctan2(rel[..., 0], -rel[..., 1])  # round the head
+    u = angle * 0.075 / STUBBLE_TILE  # ~7.5 cm radius: arc length in tiles
+    v = rel[..., 2] / STUBBLE_TILE
+    return bound(body, per_corner(mesh, np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)),
+                 faces)  # fmt: skip

@@ -14,6 +14,7 @@ v in [0, 0.5] strand cards from root (v = 0.5) to tip (v = 0), alpha thinning at
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import (
@@ -198,6 +199,47 @@ def grow_cards(
     return _card_piece(body, path, normal, width, rng)
 
 
+def cards_on(
+    body: AuthoringBody,
+    keep: np.ndarray,
+    flow,
+    count: int,
+    length=(0.01, 0.02),
+    width: float = 0.006,
+    lift=(0.0015, 0.004),
+    segments: int = 2,
+    seed: int = 0,
+    fade: float = 0.0,
+) -> Piece:
+    """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
+    ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
+    rising from the skin to a random lift in ``lift`` (m) over their length (beards,
+    moustaches). UVs as ``grow_cards``'. The cards are bound to the chosen faces only, so
+    a moustache hanging over the lips rides the upper lip, not the jaw below it. Within
+    ``fade`` m of the region's edge the cards thin out and get shorter and flatter.
+    (At most ``count`` cards: roots are drawn twice over, then thinned at the edges.)"""
+    rng = np.random.default_rng([seed, count])
+    roots = _scatter(body, keep, 2 * count, rng)
+    # Thinner, shorter and flatter towards the region's edges (no hard line where it ends).
+    edge = body.vertices[body.skin_faces[~keep]].mean(axis=1)
+    inward = np.clip(cKDTree(edge).query(roots)[0] / fade, 0, 1) if fade > 0 else np.ones(
+        len(roots))  # fmt: skip
+    pick = np.flatnonzero(rng.uniform(size=len(roots)) < 0.15 + 0.85 * inward)[:count]
+    roots, inward = roots[pick], inward[pick]
+    count = len(roots)
+    size = rng.uniform(length[0], length[1], count) * (0.5 + 0.5 * inward)
+    top = rng.uniform(lift[0], lift[1], count) * (0.4 + 0.6 * inward)
+    rows, point = [roots], roots
+    for k in range(1, segments + 1):
+        step = _tangent(body, point, flow(point))
+        point = _above_skin(body, point + step * (size / segments)[:, None],
+                            0.0008 + (top - 0.0008) * (k / segments))  # fmt: skip
+        rows.append(point)
+    path = np.stack(rows, 1)
+    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep])
+
+
 def _scatter(body: AuthoringBody, keep: np.ndarray, count: int, rng) -> np.ndarray:
     """(count, 3) random points on the chosen skin faces, uniform by area."""
     quads = body.vertices[body.skin_faces[keep]]
@@ -311,8 +353,10 @@ def long_cards(
     return _card_piece(body, path, normal, width, rng)
 
 
-def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng) -> Piece:
-    """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin."""
+def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
+                surface: np.ndarray | None = None) -> Piece:  # fmt: skip
+    """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
+    (or to ``surface``, (S, 4) base-mesh faces of it)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
@@ -328,7 +372,7 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     uv = np.concatenate([left, left + [0.12, 0.0]], 1).reshape(-1, 2).astype(np.float32)
     mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
     mesh = Mesh(mesh.vertices, mesh.faces, uv, mesh.faces.copy())
-    return bound(body, mesh, body.skin_faces)
+    return bound(body, mesh, body.skin_faces if surface is None else surface)
 
 
 def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 60, seed: int = 2) -> Piece:

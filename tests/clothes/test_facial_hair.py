@@ -1,0 +1,90 @@
+"""Facial hair: a short beard and a moustache (strand cards) and stubble (a tiled layer on
+the skin), grown from the base mesh's face so they fit every body, stay outside the skin
+with the mouth open and ride the jaw."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar.clothes import face, library
+from avatar.clothes.library import authoring_body, load_garment
+from avatar.geometry import collision
+from avatar.human import Human
+
+ITEMS = ("beard-short", "moustache", "stubble")
+
+
+def test_facial_hair_is_in_the_library():
+    entries = {e.name: e for e in library.list_garments()}
+    for name in ITEMS:
+        assert entries[name].category == "beard"
+        assert library.mhm_kind(entries[name]) == "clothes"  # MakeHuman has no beard slot
+    assert {e.name for e in library.list_garments("facial hair")} == set(ITEMS)
+    beard = load_garment("beard-short", texture_size=64)
+    stubble = load_garment("stubble", texture_size=64)
+    assert beard.material.alpha_mode == "MASK" and beard.material.base_color_texture.shape[2] == 4
+    assert stubble.material.alpha_mode == "BLEND" and not stubble.collide
+
+
+def test_beard_leaves_lips_and_forehead_bare():
+    body = authoring_body()
+    lips = face._region(body, "lips", 0.25)
+    _, mouth, eye_z, chin_z = face.mouth_frame(body)
+    for part in ("beard", "moustache"):
+        mask = face.facial_hair_mask(body, part)
+        assert mask.sum() > 100 and not (mask & lips).any()
+        c = body.vertices[body.skin_faces[mask]].mean(axis=1)
+        assert c[:, 2].max() < eye_z
+    beard = body.vertices[body.skin_faces[face.facial_hair_mask(body, "beard")]].mean(axis=1)
+    assert beard[:, 2].min() < chin_z  # under the chin
+    assert np.abs(beard[:, 0]).max() > 0.06  # out to the jaw's angle and sideburns
+
+
+@pytest.mark.parametrize("params", [
+    {"gender": 1.0},
+    {"gender": 1.0, "expression/jawOpen": 1.0},
+    {"gender": 1.0, "weight": 1.0, "age": 1.0, "expression/jawOpen": 0.8},
+    {"gender": 0.8, "age": 0.3, "muscle": 1.0, "expression/mouthSmileLeft": 1.0,
+     "expression/mouthSmileRight": 1.0},
+])  # fmt: skip
+def test_facial_hair_stays_outside_the_skin(params):
+    human = Human(params).dressed(*ITEMS)
+    faces = human.model.base.faces[human.model.base.face_groups["body"]]
+    for part in library.parts(human.outfit):
+        _, depth = collision.penetration(human.vertices[:13380], faces, part.mesh.vertices)
+        assert depth.max() <= 0.001, f"{part.name}: {depth.max() * 1000:.2f} mm inside"
+
+
+def test_beard_follows_the_jaw():
+    shut = Human({"gender": 1.0}).dressed("beard-short", "moustache")
+    open_ = Human({"gender": 1.0, "expression/jawOpen": 1.0}).dressed("beard-short", "moustache")
+    mouth = shut.vertices[shut.model.base.groups["helper-upper-teeth"]].mean(axis=0)
+    drops = {}
+    for g_shut, g_open in zip(shut.outfit.garments, open_.outfit.garments, strict=True):
+        before, after = g_shut.mesh.vertices, g_open.mesh.vertices
+        drops[g_shut.name] = drop = before[:, 2] - after[:, 2]
+        if g_shut.name == "beard-short":
+            chin = (before[:, 2] < mouth[2] - 0.035) & (before[:, 1] < mouth[1])
+            assert chin.sum() > 100 and np.median(drop[chin]) > 0.01  # the chin's hair drops
+            # ... carried by the jaw bone when the rig moves it.
+            jaw = shut.skeleton.names.index("jaw")
+            w = g_shut.weights
+            on_jaw = (w.weights * (w.indices == jaw)).sum(axis=1)
+            assert np.median(on_jaw[chin]) > 0.5
+            chin_drop = np.median(drop[chin])
+    # The moustache rides the upper lip (which jawOpen lowers a little), not the jaw.
+    assert np.median(drops["moustache"]) < 0.6 * chin_drop
+    assert np.percentile(drops["moustache"], 95) < 0.9 * chin_drop
+
+
+def test_stubble_texture_tiles_and_is_see_through():
+    from avatar.looks import facial_hair
+
+    alpha = facial_hair.stubble_alpha(256)
+    assert 0.2 < alpha.mean() / 255 < 0.6  # skin shows between the stubs
+    assert alpha.min() > 0  # a faint shadow everywhere: no bald spots in the tile
+    # Columns wrap: the first and last columns are as alike as neighbouring columns are.
+    seam = np.abs(alpha[:, 0].astype(int) - alpha[:, -1]).mean()
+    inner = np.abs(alpha[:, 100].astype(int) - alpha[:, 101]).mean()
+    assert seam < 2 * inner + 5
