@@ -1,197 +1,217 @@
-"""Small rotation-matrix helpers for the per-frame solver (3x3, float64).
+"""Rotation helpers for the per-frame solver, on plain floats.
 
-One frame's solve works on a few dozen single bones; at that size 3x3 matrix products are
-cheaper than quaternion arrays, so the solver keeps matrices and converts once at the end.
+A frame's solve turns a couple of dozen bones one after another, each a handful of 3x3
+products: at that size a numpy call's fixed cost (~1 us) dwarfs its arithmetic, so the solver
+keeps its matrices as row-major 9-tuples and its vectors as 3-tuples of Python floats
+(``M`` and ``V`` below) and goes to numpy only where a call does real work: the SVD of a
+rigid fit and the final matrix -> quaternion conversion of all bones at once.
+
+Conventions: ``M`` (m00, m01, m02, m10, ..., m22); rotations act on column vectors
+(``apply(m, v)`` is ``m @ v``); angles in radians.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
-EYE = np.eye(3)
+M = tuple[float, float, float, float, float, float, float, float, float]
+V = tuple[float, float, float]
+
+EYE: M = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+ZERO: V = (0.0, 0.0, 0.0)
+
+# The SVD gufunc behind ``np.linalg.svd``: the same LAPACK call, without the wrapper's
+# argument checks and error-state context (half the cost of a 3x3 SVD). numpy 2 names it
+# ``svd_f``, 1.x ``svd_m_f``; anything else falls back to the public function.
+try:
+    _LINALG = importlib.import_module("numpy.linalg._umath_linalg")
+    _SVD = getattr(_LINALG, "svd_f", None) or getattr(_LINALG, "svd_m_f", None)
+except ImportError:  # pragma: no cover - a numpy without the private module
+    _SVD = None
 
 
-def unit(v: np.ndarray) -> np.ndarray:
-    n = math.sqrt(float(v @ v))
-    return v / n if n > 1e-12 else v
+def svd3(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(u, s, vt) of a (3, 3) float64 matrix, as ``np.linalg.svd``."""
+    if _SVD is None:
+        return np.linalg.svd(h)
+    return _SVD(h, signature="d->ddd")
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b for two 3-vectors (numpy's ``cross`` costs ten times more at this size)."""
-    a0, a1, a2 = a.tolist()
-    b0, b1, b2 = b.tolist()
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+def mul(a: Sequence[float], b: Sequence[float]) -> M:
+    """a @ b."""
+    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
+    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
+    return (a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7, a0 * b2 + a1 * b5 + a2 * b8,
+            a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7, a3 * b2 + a4 * b5 + a5 * b8,
+            a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7,
+            a6 * b2 + a7 * b5 + a8 * b8)  # fmt: skip
 
 
-def axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
-    """(3, 3) rotation of ``angle`` radians about unit ``axis`` (Rodrigues)."""
-    x, y, z = (float(v) for v in axis)
+def tmul(a: Sequence[float], b: Sequence[float]) -> M:
+    """a.T @ b."""
+    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
+    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
+    return (a0 * b0 + a3 * b3 + a6 * b6, a0 * b1 + a3 * b4 + a6 * b7, a0 * b2 + a3 * b5 + a6 * b8,
+            a1 * b0 + a4 * b3 + a7 * b6, a1 * b1 + a4 * b4 + a7 * b7, a1 * b2 + a4 * b5 + a7 * b8,
+            a2 * b0 + a5 * b3 + a8 * b6, a2 * b1 + a5 * b4 + a8 * b7,
+            a2 * b2 + a5 * b5 + a8 * b8)  # fmt: skip
+
+
+def apply(m: Sequence[float], v: Sequence[float]) -> V:
+    """m @ v."""
+    x, y, z = v
+    return (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
+            m[6] * x + m[7] * y + m[8] * z)  # fmt: skip
+
+
+def tapply(m: Sequence[float], v: Sequence[float]) -> V:
+    """m.T @ v."""
+    x, y, z = v
+    return (m[0] * x + m[3] * y + m[6] * z, m[1] * x + m[4] * y + m[7] * z,
+            m[2] * x + m[5] * y + m[8] * z)  # fmt: skip
+
+
+def add(a: Sequence[float], b: Sequence[float]) -> V:
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def sub(a: Sequence[float], b: Sequence[float]) -> V:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def dot(a: Sequence[float], b: Sequence[float]) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a: Sequence[float], b: Sequence[float]) -> V:
+    a0, a1, a2 = a
+    b0, b1, b2 = b
+    return (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+
+
+def unit(v: Sequence[float]) -> V:
+    """v / |v|, or v itself when shorter than 1e-12."""
+    x, y, z = v
+    n = math.sqrt(x * x + y * y + z * z)
+    return (x / n, y / n, z / n) if n > 1e-12 else (x, y, z)
+
+
+def weighted_sum(vectors: Sequence[Sequence[float]], weights: Sequence[float]) -> V:
+    """sum_i w_i v_i of 3-vectors."""
+    x = y = z = 0.0
+    for (a, b, c), w in zip(vectors, weights, strict=True):
+        x += w * a
+        y += w * b
+        z += w * c
+    return (x, y, z)
+
+
+def turn(axis: Sequence[float], angle: float) -> M:
+    """Rotation of ``angle`` about unit ``axis`` (Rodrigues: c I + s [a]x + (1 - c) a a^T;
+    an angle of 0 gives the identity exactly)."""
+    x, y, z = axis
     s, c = math.sin(angle), math.cos(angle)
     t = 1.0 - c
-    return np.array([[c + t * x * x, t * x * y - s * z, t * x * z + s * y],
-                     [t * x * y + s * z, c + t * y * y, t * y * z - s * x],
-                     [t * x * z - s * y, t * y * z + s * x, c + t * z * z]])  # fmt: skip
+    return (c + t * x * x, t * x * y - s * z, t * x * z + s * y,
+            t * x * y + s * z, c + t * y * y, t * y * z - s * x,
+            t * x * z - s * y, t * y * z + s * x, c + t * z * z)  # fmt: skip
 
 
-def between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(3, 3) shortest-arc rotation taking direction a to direction b (3,)."""
+def rotate(axis: Sequence[float], c: float, s: float, v: Sequence[float]) -> V:
+    """v turned about unit ``axis`` by the angle of cosine c and sine s (Rodrigues on a
+    vector: ``turn(axis, angle) @ v`` without the matrix)."""
+    x, y, z = axis
+    vx, vy, vz = v
+    k = (1.0 - c) * (x * vx + y * vy + z * vz)
+    return (c * vx + s * (y * vz - z * vy) + k * x, c * vy + s * (z * vx - x * vz) + k * y,
+            c * vz + s * (x * vy - y * vx) + k * z)  # fmt: skip
+
+
+def arc(a: Sequence[float], b: Sequence[float]) -> M:
+    """Shortest-arc rotation taking direction a to direction b (either of length 0 or the
+    two opposite: a half turn about an axis across a)."""
     a, b = unit(a), unit(b)
     c = cross(a, b)
-    s = math.sqrt(float(c @ c))
-    d = float(a @ b)
+    s = math.sqrt(dot(c, c))
+    d = dot(a, b)
     if s < 1e-9:
         if d > 0:
-            return EYE.copy()
-        other = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        return axis_angle(unit(cross(a, other)), math.pi)
-    return axis_angle(c / s, math.atan2(s, d))
+            return EYE
+        other = (1.0, 0.0, 0.0) if abs(a[0]) < 0.9 else (0.0, 1.0, 0.0)
+        return turn(unit(cross(a, other)), math.pi)
+    return turn((c[0] / s, c[1] / s, c[2] / s), math.atan2(s, d))
 
 
-def angle_of(r: np.ndarray) -> float:
-    """Rotation angle of a (3, 3) rotation, radians in [0, pi]."""
-    c = (float(r[0, 0]) + float(r[1, 1]) + float(r[2, 2]) - 1.0) * 0.5
+def angle(r: Sequence[float]) -> float:
+    """Rotation angle of r, in [0, pi]."""
+    c = (r[0] + r[4] + r[8] - 1.0) * 0.5
     return math.acos(min(max(c, -1.0), 1.0))
 
 
-def log(r: np.ndarray) -> tuple[np.ndarray, float]:
-    """(axis (3,), angle) of a rotation matrix."""
-    angle = angle_of(r)
-    if angle < 1e-9:
-        return np.array([1.0, 0.0, 0.0]), 0.0
-    if angle > np.pi - 1e-6:  # axis from the symmetric part
-        m = (r + EYE) * 0.5
-        axis = unit(m[int(np.argmax(np.diag(m)))])
-        return axis, angle
-    axis = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    return axis / (2.0 * math.sin(angle)), angle
+def log(r: Sequence[float]) -> tuple[V, float]:
+    """(unit axis, angle) of a rotation; (x axis, 0) for the identity."""
+    a = angle(r)
+    if a < 1e-9:
+        return (1.0, 0.0, 0.0), 0.0
+    if a > math.pi - 1e-6:  # near a half turn: the axis from the symmetric part
+        diag = (r[0], r[4], r[8])
+        i = diag.index(max(diag))
+        row = [(r[3 * i + j] + (1.0 if i == j else 0.0)) * 0.5 for j in range(3)]
+        return unit(row), a
+    s = 2.0 * math.sin(a)
+    return ((r[7] - r[5]) / s, (r[2] - r[6]) / s, (r[3] - r[1]) / s), a
 
 
-def power(r: np.ndarray, f: float) -> np.ndarray:
-    """r to the power f (the same axis, f times the angle): slerp from identity."""
-    axis, angle = log(r)
-    return axis_angle(axis, angle * f) if angle else EYE.copy()
+def power(r: Sequence[float], f: float) -> M:
+    """r to the power f: the same axis, f times the angle (a slerp from the identity)."""
+    axis, a = log(r)
+    return turn(axis, a * f) if a else EYE
 
 
-def kabsch(a: np.ndarray, b: np.ndarray, w: np.ndarray) -> np.ndarray | None:
-    """(3, 3) rotation R minimising sum w_i |R a_i - b_i|^2 (vectors about a fixed centre),
-    or None when the points do not fix a rotation (fewer than two independent directions)."""
-    h = (a * w[:, None]).T @ b
-    u, s, vt = np.linalg.svd(h)
-    if s[1] < 1e-9 * max(s[0], 1e-300):
+def clamp(r: M, max_angle: float) -> M:
+    """r turned back towards the identity so its angle is at most ``max_angle``."""
+    if angle(r) <= max_angle:
+        return r
+    axis, _ = log(r)
+    return turn(axis, max_angle)
+
+
+def kabsch(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]],
+           w: Sequence[float]) -> M | None:  # fmt: skip
+    """Rotation R minimising sum w_i |R a_i - b_i|^2 (vectors about a fixed centre), or None
+    when the points do not fix one (fewer than two independent directions)."""
+    h = [0.0] * 9
+    for (a0, a1, a2), (b0, b1, b2), wi in zip(a, b, w, strict=True):
+        a0, a1, a2 = a0 * wi, a1 * wi, a2 * wi
+        h[0] += a0 * b0
+        h[1] += a0 * b1
+        h[2] += a0 * b2
+        h[3] += a1 * b0
+        h[4] += a1 * b1
+        h[5] += a1 * b2
+        h[6] += a2 * b0
+        h[7] += a2 * b1
+        h[8] += a2 * b2
+    u, s, vt = svd3(np.array(h).reshape(3, 3))
+    s0, s1, _ = s.tolist()
+    if not s1 >= 1e-9 * max(s0, 1e-300):  # (NaN from a non-finite input too)
         return None
-    r = vt.T @ u.T
-    if det3(r) < 0:  # a reflection: flip the least significant axis
-        vt[2] = -vt[2]
-        r = vt.T @ u.T
+    v = vt.T.ravel().tolist()
+    ut = u.T.ravel().tolist()
+    r = mul(v, ut)
+    if det(r) < 0:  # a reflection: flip the least significant axis
+        v[2], v[5], v[8] = -v[2], -v[5], -v[8]
+        r = mul(v, ut)
     return r
 
 
-def det3(m: np.ndarray) -> float:
-    """Determinant of a (3, 3) matrix (plain floats: a tenth of ``np.linalg.det``'s cost)."""
-    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+def det(m: Sequence[float]) -> float:
+    a, b, c, d, e, f, g, h, i = m
     return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-
-
-def clamp(r: np.ndarray, max_angle: float) -> np.ndarray:
-    """r turned back towards the identity so its angle is at most ``max_angle`` radians."""
-    angle = angle_of(r)
-    if angle <= max_angle:
-        return r
-    axis, angle = log(r)
-    return axis_angle(axis, max_angle)
-
-
-# -- batched forms: (n, 3, 3) stacks, a fixed handful of numpy calls per stack --------------
-# One frame solves every limb bone of a level (both arms and legs) in one call of these,
-# which is what keeps a frame under a millisecond: numpy's per-call cost, not arithmetic,
-# dominates at 3x3.
-
-# (3, 9): a @ _SKEW gives the flattened cross-product matrix [a]x of each row of a.
-_SKEW = np.zeros((3, 9))
-for _k, (_i, _j, _s) in enumerate(((2, 1, 1.0), (1, 2, -1.0), (0, 2, 1.0), (2, 0, -1.0),
-                                   (1, 0, 1.0), (0, 1, -1.0))):  # fmt: skip
-    _SKEW[[0, 0, 1, 1, 2, 2][_k], _i * 3 + _j] = _s
-_NEXT, _AFTER = [1, 2, 0], [2, 0, 1]
-
-
-def cross_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(n, 3) row-wise a x b (cheaper than ``np.cross`` for small n)."""
-    return a[:, _NEXT] * b[:, _AFTER] - a[:, _AFTER] * b[:, _NEXT]
-
-
-def turns_about(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) rotations about one unit ``axis`` (3,) by ``angles`` (n,) radians."""
-    c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
-    skew = (axis @ _SKEW).reshape(3, 3)
-    outer = axis[:, None] * axis[None, :]
-    return c * (EYE - outer) + s * skew + outer
-
-
-def axis_angle_many(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) rotations of ``angles`` (n,) radians about unit ``axes`` (n, 3)
-    (Rodrigues: c I + s [a]x + (1 - c) a a^T; an angle of 0 gives the identity exactly)."""
-    c, s = np.cos(angles)[:, None, None], np.sin(angles)[:, None, None]
-    skew = (axes @ _SKEW).reshape(-1, 3, 3)
-    return c * EYE + s * skew + (1.0 - c) * (axes[:, :, None] * axes[:, None, :])
-
-
-def angle_many(r: np.ndarray) -> np.ndarray:
-    """(n,) rotation angles of (n, 3, 3) rotations, radians in [0, pi]."""
-    c = (r[:, 0, 0] + r[:, 1, 1] + r[:, 2, 2] - 1.0) * 0.5
-    return np.arccos(np.clip(c, -1.0, 1.0))
-
-
-def log_many(r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(axes (n, 3), angles (n,)) of (n, 3, 3) rotations, as ``log`` row by row."""
-    angles = angle_many(r)
-    vee = np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], 1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        axes = vee / (2.0 * np.sin(angles))[:, None]
-    odd = (angles < 1e-9) | (angles > np.pi - 1e-6)
-    for i in np.flatnonzero(odd):  # identity or a half turn: rare, the scalar form
-        axes[i], angles[i] = log(r[i])
-    return axes, angles
-
-
-def power_many(r: np.ndarray, f: float | np.ndarray) -> np.ndarray:
-    """(n, 3, 3): each rotation to the power f (scalar or (n,)), as ``power``."""
-    axes, angles = log_many(r)
-    return axis_angle_many(axes, angles * f)
-
-
-def between_many(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) shortest-arc rotations taking directions a (n, 3) to b (n, 3), as
-    ``between`` row by row."""
-    na = np.sqrt((a * a).sum(1))[:, None]
-    nb = np.sqrt((b * b).sum(1))[:, None]
-    a = np.where(na > 1e-12, a / np.where(na > 1e-12, na, 1.0), a)
-    b = np.where(nb > 1e-12, b / np.where(nb > 1e-12, nb, 1.0), b)
-    c = cross_many(a, b)
-    s = np.sqrt((c * c).sum(1))
-    d = (a * b).sum(1)
-    flat = s < 1e-9
-    axes = c / np.where(flat, 1.0, s)[:, None]
-    out = axis_angle_many(axes, np.where(flat, 0.0, np.arctan2(s, d)))
-    for i in np.flatnonzero(flat & (d <= 0)):  # opposite directions: rare, the scalar form
-        out[i] = between(a[i], b[i])
-    return out
-
-
-def kabsch_many(a: np.ndarray, b: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``kabsch`` for n point sets at once: a, b (n, m, 3), w (n, m) (zero weights pad sets
-    of fewer points). Returns rotations (n, 3, 3) and (n,) bool: False where the points do
-    not fix a rotation (that row's matrix is then meaningless)."""
-    h = (a * w[:, :, None]).transpose(0, 2, 1) @ b
-    u, s, vt = np.linalg.svd(h)
-    ok = s[:, 1] >= 1e-9 * np.maximum(s[:, 0], 1e-300)
-    v = vt.transpose(0, 2, 1)
-    ut = u.transpose(0, 2, 1)
-    d = np.sign(np.linalg.det(v @ ut))
-    d[d == 0] = 1.0
-    v[:, :, 2] *= d[:, None]
-    return v @ ut, ok
 
 
 # Matrix -> quaternion in one product: the four candidate quaternions of Shepperd's method
@@ -215,7 +235,7 @@ for _row, _terms in enumerate((
 
 
 def quaternions(r: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) rotations -> (n, 4) unit quaternions (w, x, y, z) with w >= 0
+    """(n, 3, 3) or (n, 9) rotations -> (n, 4) unit quaternions (w, x, y, z) with w >= 0
     (``avatar.rig.quaternion.from_matrix``, in a few calls)."""
     n = len(r)
     cands = (r.reshape(n, 9) @ _QUAT_MAP + _QUAT_ONE).reshape(n, 4, 4)

@@ -31,6 +31,8 @@ calls whatever the rig (``bench/mocap.py`` times it).
 from __future__ import annotations
 
 import math
+import statistics
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,7 +42,7 @@ from avatar.mocap import rotations as rot
 from avatar.mocap.feet import FootPlanter
 from avatar.mocap.filters import OneEuro, PointFilter
 from avatar.mocap.keypoints import RigKeypoints
-from avatar.mocap.plan import Batch, Plan, make_plan
+from avatar.mocap.plan import Plan, make_plan
 from avatar.rig.skeleton import Animation
 
 
@@ -85,35 +87,161 @@ class SolvedFrame:
     contacts: np.ndarray
 
 
+@dataclass(frozen=True, slots=True)
+class _Bone:
+    """What a solved bone needs every frame, from the plan, as plain floats and ints.
+
+    anchor: step index of the nearest solved bone above (-1 for the root); rel (9,) its rest
+    rotation in the anchor's rest frame and step (3,) its rest head in the anchor's frame;
+    points: keypoints carried, offsets in this bone's frame; origin: the keypoint at its
+    head (-1: none); pole: (mid keypoint, far keypoint, bend axis in this bone's frame) for
+    upper arms and thighs; limit: radians (``limited`` when below a half turn).
+    """
+
+    anchor: int
+    rel: rot.M
+    step: rot.V
+    points: tuple[int, ...]
+    offsets: tuple[rot.V, ...]
+    origin: int
+    pole: tuple[int, int, rot.V] | None
+    limit: float
+    limited: bool
+
+
+@dataclass(frozen=True, slots=True)
+class _Chain:
+    """A chain (``plan.Chain``) prepared for the per-frame solve.
+
+    steps: its bones (step indices, first to last), anchor: the first one's anchor;
+    rest_rel: each bone's rest rotation in the first bone's rest frame; hops: for bone k >= 1
+    the vector from bone k-1's head to bone k's, in the first bone's rest frame (hops[0]
+    unused); limits: radians.
+    points: the chain's keypoints and offsets (in the first bone's rest frame, everything at
+    rest, for the initial fit); per point the chain bone ``carrier`` that turns it and, for
+    the points riding on a tip (a solved bone hanging on the chain: clavicles, head),
+    ``tip`` (index into tips, -1: on a chain bone) with ``lever`` (for chain-bone points:
+    the offset in the first bone's rest frame from the carrier's head, at rest).
+    tips: (step, index in steps of the bone it hangs on, the tip's head from that bone's
+    head in the first bone's rest frame, its rest rotation in the first bone's rest frame).
+    """
+
+    name: str
+    steps: tuple[int, ...]
+    anchor: int
+    rest_rel: tuple[rot.M, ...]
+    hops: tuple[rot.V, ...]
+    limits: tuple[float, ...]
+    points: tuple[int, ...]
+    offsets: tuple[rot.V, ...]
+    carrier: tuple[int, ...]
+    tip: tuple[int, ...]
+    lever: tuple[rot.V, ...]
+    tips: tuple[tuple[int, int, rot.V, rot.M], ...]
+    tip_ids: tuple[int, ...]
+
+
+def _m(a: np.ndarray) -> rot.M:
+    return tuple(float(v) for v in np.asarray(a, dtype=np.float64).reshape(9))  # type: ignore[return-value]
+
+
+def _v(a: np.ndarray) -> rot.V:
+    return tuple(float(v) for v in np.asarray(a, dtype=np.float64).reshape(3))  # type: ignore[return-value]
+
+
 class PoseSolver:
-    """Streaming solver for one rig and keypoint set: ``solver(points, confidence, t)``."""
+    """Streaming solver for one rig and keypoint set: ``solver(points, confidence, t)``.
+
+    Everything that depends only on the rig and the keypoint set (the plan, rest frames,
+    lengths, index lists) is prepared here once; a frame then walks the bones with plain
+    float arithmetic (``rotations``), going to numpy for the input filter, the SVDs of rigid
+    fits and the final conversion to quaternions.
+    """
 
     def __init__(self, rig: RigKeypoints, settings: SolverSettings | None = None):
         self.settings = settings or SolverSettings()
         self.plan: Plan = make_plan(rig)
         self.rig = rig
         sk = rig.skeleton
-        self._rest = sk.rest[:, :3, :3]
-        self._hips = self.plan.steps[0].bone
+        steps = self.plan.steps
+        self._count = len(steps)
+        self._hips = steps[0].bone
+        self._bone = [self._prepare_bone(st) for st in steps]
+        self._hips_rest = _m(sk.rest[self._hips, :3, :3])
+        self._hips_head = _v(sk.heads[self._hips])
         sho = [k for k in self.plan.shoulder_points if k >= 0]
-        self._root_points = np.concatenate([self.plan.steps[0].points, np.array(sho, int)])
-        self._root_offsets = np.concatenate([
-            self.plan.steps[0].offsets,
-            (rig.rest[sho] - sk.heads[self._hips]) @ self._rest[self._hips]])  # fmt: skip
+        root_offsets = np.concatenate([steps[0].offsets,
+                                       (rig.rest[sho] - sk.heads[self._hips])
+                                       @ sk.rest[self._hips, :3, :3]])  # fmt: skip
+        self._root_points = [int(k) for k in steps[0].points] + sho
+        self._root_offsets = [_v(o) for o in root_offsets]
+        self._knees = [self._knee(side) for side in (0, 1)]
+        feet = [sk.heads[st.bone, 2] for st in steps if st.role.startswith("foot.")]
+        self._rest_ankle = float(np.mean(feet)) if feet else 0.08
+        self._chains = {name: self._prepare_chain(c, name) for name, c in self.plan.chains.items()}
+        self._schedule = self._prepare_schedule()
         self._feet = FootPlanter(self.plan)
-        self._bones = np.array([st.bone for st in self.plan.steps])
-        carried = [(k, i, st.offsets[r]) for i, st in enumerate(self.plan.steps)
+        # Output: quaternions of the solved bones into (J, 4), keypoints from their carriers.
+        self._bones = np.array([st.bone for st in steps])
+        self._identity = np.tile([1.0, 0.0, 0.0, 0.0], (len(sk.names), 1))
+        carried = [(k, i, st.offsets[r]) for i, st in enumerate(steps)
                    for r, k in enumerate(st.points)]  # fmt: skip
         self._point_ids = np.array([c[0] for c in carried], dtype=int)
         self._point_owner = np.array([c[1] for c in carried], dtype=int)
-        self._point_offsets = np.array([c[2] for c in carried]).reshape(-1, 3)
+        self._point_offsets = np.array([c[2] for c in carried]).reshape(-1, 3, 1)
         self.reset()
+
+    def _prepare_bone(self, st) -> _Bone:
+        pole = None if st.pole is None else (int(st.pole[0]), int(st.pole[1]), _v(st.pole[2]))
+        return _Bone(int(st.anchor), _m(st.rel), _v(st.step), tuple(int(k) for k in st.points),
+                     tuple(_v(o) for o in st.offsets), int(st.origin), pole, float(st.limit),
+                     bool(st.limit < math.pi))  # fmt: skip
+
+    def _prepare_chain(self, chain, name: str) -> _Chain:
+        steps = self.plan.steps
+        ids = list(chain.steps)
+        rest_rel = [np.asarray(r) for r in chain.rest_rel]
+        hops = [np.zeros(3)] + [rest_rel[k - 1] @ chain.step[k] for k in range(1, len(ids))]
+        tips = []
+        for r, i in enumerate(chain.tips):
+            on = int(chain.tip_on[r])
+            tips.append((i, on, _v(rest_rel[on] @ steps[i].step), _m(rest_rel[on] @ steps[i].rel)))
+        carrier, tip, lever = [], [], []
+        for own, off in zip(chain.owner, chain.owner_offsets, strict=True):
+            if own < len(ids):
+                carrier.append(int(own))
+                tip.append(-1)
+                lever.append(_v(rest_rel[own] @ off))
+            else:
+                carrier.append(tips[own - len(ids)][1])
+                tip.append(int(own) - len(ids))
+                lever.append(_v(off))  # in the tip's own frame: turned by its pose each pass
+        return _Chain(name, tuple(ids), int(chain.anchor), tuple(_m(r) for r in rest_rel),
+                      tuple(_v(h) for h in hops), tuple(float(x) for x in chain.limit),
+                      tuple(int(k) for k in chain.points), tuple(_v(o) for o in chain.offsets),
+                      tuple(carrier), tuple(tip), tuple(lever), tuple(tips),
+                      tuple(int(i) for i in chain.tips))  # fmt: skip
+
+    def _prepare_schedule(self) -> list[tuple[str, object]]:
+        """The plan's schedule with batches as step lists and chains prepared; the spine's
+        tips (clavicles) solved between two passes of the spine, as the plan orders."""
+        out: list[tuple[str, object]] = []
+        for kind, item in self.plan.schedule[1:]:
+            if kind == "chain":
+                chain = self._chains[str(item)]
+                out.append(("chain", chain))
+                tips = self.plan.chains[str(item)].tip_batch
+                if item == "spine_chain" and tips is not None:
+                    out.append(("bones", [int(i) for i in tips.steps]))
+                    out.append(("chain", chain))
+            else:
+                out.append(("bones", [int(i) for i in item.steps]))  # type: ignore[attr-defined]
+        return out
 
     def reset(self) -> None:
         """Forget the stream (filter state, held rotations, scale, floor, contacts)."""
-        count = len(self.plan.steps)
-        self._last = np.tile(np.eye(3), (count, 1, 1))
-        self._root = self.rig.skeleton.heads[self._hips].copy()
+        self._last: list[rot.M] = [rot.EYE] * self._count
+        self._root: rot.V = self._hips_head
         self._filter = PointFilter(len(self.rig.keypoints.names), self.settings.smoothing)
         self._legs: list[float] = []
         self._scale = None if self.settings.scale == "auto" else float(self.settings.scale)
@@ -135,137 +263,116 @@ class PoseSolver:
         t = (0.0 if self._time is None else self._time + 1 / 30) if t is None else float(t)
         dt = 1 / 30 if self._time is None else max(t - self._time, 1e-6)
         self._time = t
-        bad = ~np.isfinite(p).all(axis=1)
+        finite = np.isfinite(p).all(axis=1)
         if confidence is not None:
             c = np.asarray(confidence, dtype=np.float64).reshape(k)
-            bad |= ~(c >= self.settings.threshold)
+            bad = ~(finite & (c >= self.settings.threshold))
             w = np.where(bad, 0.0, np.nan_to_num(c))
         else:
+            bad = ~finite
             w = np.where(bad, 0.0, 1.0)
-        p = np.where(bad[:, None], np.nan, p)
+        if bad.any():
+            p = np.where(bad[:, None], np.nan, p)
         p = self._filter(p, t)
         ok = ~bad & np.isfinite(p).all(axis=1)
-        return self._solve(p, ok, w, t, dt)
+        return self._solve(p.tolist(), ok.tolist(), w.tolist(), t, dt)
 
-    def _solve(self, p, ok, w, t, dt) -> SolvedFrame:
-        n = len(self.plan.steps)
-        world = np.empty((n, 3, 3))
-        heads = np.empty((n, 3))
-        local = np.empty((n, 3, 3))
-        solved = np.zeros(n, dtype=bool)
+    def _solve(self, p: list, ok: list, w: list, t: float, dt: float) -> SolvedFrame:
+        n = self._count
         decay = math.exp(-dt / self.settings.hold) if self.settings.hold > 0 else 0.0
-        frame = _Frame(p, ok, w, world, heads, local, solved, decay)
-        self._solve_root(frame)
-        for kind, item in self.plan.schedule[1:]:
+        f = _Frame(p, ok, w, [rot.EYE] * n, [rot.ZERO] * n, [rot.EYE] * n, [False] * n, decay)
+        self._solve_root(f)
+        for kind, item in self._schedule:
             if kind == "chain":
-                self._solve_chain(frame, str(item))
-                tips = self.plan.chains[str(item)].tip_batch
-                if item == "spine_chain" and tips is not None:
-                    self._solve_bones(frame, tips)  # again, with the clavicles just solved
-                    self._solve_chain(frame, "spine_chain")
+                self._solve_chain(f, item)  # type: ignore[arg-type]
             else:
-                self._solve_bones(frame, item)  # type: ignore[arg-type]
+                for i in item:  # type: ignore[attr-defined]
+                    self._solve_bone(f, i)
         contacts = np.zeros(2, dtype=bool)
         if self.settings.plant_feet:
-            contacts = self._feet(frame, dt, self._inherit)
-        return self._output(frame, t, contacts)
+            contacts = self._feet(f, dt, self._inherit)
+        return self._output(f, t, contacts)
 
-    def _inherit(self, f: _Frame, i: int) -> tuple[np.ndarray, np.ndarray]:
-        """(world rotation with this bone at rest relative to its anchor, head)."""
-        st = self.plan.steps[i]
-        wa = f.world[st.anchor]
-        return wa @ st.rel, f.heads[st.anchor] + wa @ st.step
+    def _inherit(self, f: _Frame, i: int) -> tuple[rot.M, rot.V]:
+        """(world rotation with bone i at rest relative to its anchor, its head)."""
+        b = self._bone[i]
+        wa = f.world[b.anchor]
+        return rot.mul(wa, b.rel), rot.add(f.heads[b.anchor], rot.apply(wa, b.step))
 
-    def _finish(self, f: _Frame, i: int, base: np.ndarray, world: np.ndarray | None) -> None:
-        """Record bone i's pose: ``world`` solved (None: held), limits applied."""
-        st = self.plan.steps[i]
-        if world is None:
-            self._last[i] = rot.power(self._last[i], f.decay) if f.decay else np.eye(3)
-            local = self._last[i]
+    def _finish(self, f: _Frame, i: int, base: rot.M, local: rot.M | None) -> None:
+        """Record bone i's pose: ``local`` (relative to ``base``) solved, None: held (its
+        last good rotation, decayed towards rest); joint limits applied."""
+        if local is None:
+            local = self._last[i] = rot.power(self._last[i], f.decay) if f.decay else rot.EYE
         else:
-            local = base.T @ world
-            if self.settings.limits and st.limit < math.pi:
-                local = rot.clamp(local, st.limit)
+            b = self._bone[i]
+            if b.limited and self.settings.limits:
+                local = rot.clamp(local, b.limit)
             self._last[i] = local
             f.solved[i] = True
         f.local[i] = local
-        f.world[i] = base @ local
-
-    def _finish_many(self, f: _Frame, batch: Batch, base: np.ndarray, world: np.ndarray,
-                     solved: np.ndarray) -> None:  # fmt: skip
-        """``_finish`` for a batch: rows where ``solved`` take ``world`` (n, 3, 3), the
-        others are held."""
-        ids = batch.steps
-        local = base.transpose(0, 2, 1) @ world
-        if not solved.all():
-            held = ids[~solved]
-            last = rot.power_many(self._last[held], f.decay) if f.decay else np.eye(3)
-            self._last[held] = last
-            local[~solved] = self._last[held]
-        if self.settings.limits:
-            over = solved & batch.limited
-            if over.any():
-                over &= rot.angle_many(local) > batch.limit
-                for r in np.flatnonzero(over):  # rare: the scalar clamp
-                    local[r] = rot.clamp(local[r], float(batch.limit[r]))
-        self._last[ids[solved]] = local[solved]
-        f.solved[ids] |= solved
-        f.local[ids] = local
-        f.world[ids] = base @ local
+        f.world[i] = rot.mul(base, local)
 
     # -- root ----------------------------------------------------------------------------
 
-    def _scale_now(self, p: np.ndarray, ok: np.ndarray) -> float:
+    def _scale_now(self, p: list, ok: list) -> float:
         if self._scale is not None:
             return self._scale
         legs = []
         for side in (0, 1):
             hip, ankle = self.plan.hip_points[side], self.plan.ankle_points[side]
-            knee = self._knee(side)
-            if min(hip, ankle, knee) >= 0 and ok[[hip, knee, ankle]].all():
-                legs.append(np.linalg.norm(p[knee] - p[hip]) + np.linalg.norm(p[ankle] - p[knee]))
+            knee = self._knees[side]
+            if min(hip, ankle, knee) >= 0 and ok[hip] and ok[knee] and ok[ankle]:
+                legs.append(_length(rot.sub(p[knee], p[hip])) + _length(rot.sub(p[ankle], p[knee])))
         if legs:
-            self._legs.append(float(np.mean(legs)))
+            self._legs.append(sum(legs) / len(legs))
         if len(self._legs) >= 30:  # settle on the median of the first confident frames
-            self._scale = self.plan.leg_length / float(np.median(self._legs))
+            self._scale = self.plan.leg_length / statistics.median(self._legs)
             return self._scale
-        return self.plan.leg_length / float(np.median(self._legs)) if self._legs else 1.0
+        return self.plan.leg_length / statistics.median(self._legs) if self._legs else 1.0
 
     def _knee(self, side: int) -> int:
         st = self.plan.role_steps.get("shin." + "LR"[side])
         return -1 if st is None else self.plan.steps[st].origin
 
     def _solve_root(self, f: _Frame) -> None:
-        keep = f.ok[self._root_points]
-        idx, a = self._root_points[keep], self._root_offsets[keep]
-        rest = self._rest[self._hips]
-        if len(idx) < 3:
+        ok = f.ok
+        keep = [r for r, k in enumerate(self._root_points) if ok[k]]
+        rest = self._hips_rest
+        if len(keep) < 3:
             self._finish(f, 0, rest, None)
             f.heads[0] = self._root
             return
-        s = self._scale_now(f.p, f.ok)
-        b, wt = f.p[idx] * s, f.w[idx]
-        ca, cb = (wt @ a) / wt.sum(), (wt @ b) / wt.sum()
-        r = rot.kabsch(a - ca, b - cb, wt)
+        s = self._scale_now(f.p, ok)
+        idx = [self._root_points[r] for r in keep]
+        a = [self._root_offsets[r] for r in keep]
+        b = [_scaled(f.p[k], s) for k in idx]
+        wt = [f.w[k] for k in idx]
+        total = sum(wt)
+        ca, cb = (
+            _scaled(rot.weighted_sum(a, wt), 1 / total),
+            _scaled(rot.weighted_sum(b, wt), 1 / total),
+        )
+        r = rot.kabsch([rot.sub(v, ca) for v in a], [rot.sub(v, cb) for v in b], wt)
         if r is None:
             self._finish(f, 0, rest, None)
             f.heads[0] = self._root
             return
         hl, hr = self.plan.hip_points
-        pos = {int(k): i for i, k in enumerate(idx)}
-        if hl in pos and hr in pos:  # the hip line exactly, the tilt from the fit
-            il, ir = pos[hl], pos[hr]
-            r = rot.between(r @ (a[il] - a[ir]), b[il] - b[ir]) @ r
-            t = (b[il] + b[ir]) / 2 - r @ ((a[il] + a[ir]) / 2)
+        if hl in idx and hr in idx:  # the hip line exactly, the tilt from the fit
+            il, ir = idx.index(hl), idx.index(hr)
+            r = rot.mul(rot.arc(rot.apply(r, rot.sub(a[il], a[ir])), rot.sub(b[il], b[ir])), r)
+            mid_b = _scaled(rot.add(b[il], b[ir]), 0.5)
+            t = rot.sub(mid_b, rot.apply(r, _scaled(rot.add(a[il], a[ir]), 0.5)))
         else:
-            t = cb - r @ ca
-        lift = np.array([0.0, 0.0, self._lift(f, s)])
-        self._finish(f, 0, rest, r)
-        f.heads[0] = self._root = t + lift
-        if s != 1.0 or lift[2] != 0.0:
+            t = rot.sub(cb, rot.apply(r, ca))
+        lift = self._lift(f, s)
+        self._finish(f, 0, rest, rot.tmul(rest, r))
+        f.heads[0] = self._root = (t[0], t[1], t[2] + lift)
+        if s != 1.0 or lift != 0.0:
             # Every later step compares keypoints with bone heads: put them in the rig's
             # space, as the root was (scaled to the rig, on its floor).
-            f.p = f.p * s + lift
+            f.p = [(x * s, y * s, z * s + lift) for x, y, z in f.p]
 
     def _lift(self, f: _Frame, s: float) -> float:
         floor = self.settings.floor
@@ -273,188 +380,238 @@ class PoseSolver:
             return 0.0
         if floor != "auto":
             return -float(floor) * s
-        ankles = [k for k in self.plan.ankle_points if k >= 0 and f.ok[k]]
-        if ankles:
-            self._floor = min(self._floor, float(f.p[ankles, 2].min()) * s)
+        heights = [f.p[k][2] for k in self.plan.ankle_points if k >= 0 and f.ok[k]]
+        if heights:
+            self._floor = min(self._floor, min(heights) * s)
         if not math.isfinite(self._floor):
             return 0.0
-        sk = self.rig.skeleton
-        feet = [sk.heads[st.bone, 2] for st in self.plan.steps if st.role.startswith("foot.")]
-        return (float(np.mean(feet)) if feet else 0.08) - self._floor
+        return self._rest_ankle - self._floor
 
     # -- chains (spine, neck) --------------------------------------------------------------
 
-    def _solve_chain(self, f: _Frame, name: str) -> None:
-        chain = self.plan.chains[name]
-        given: dict[int, np.ndarray | None] = {}
-        if name == "neck_chain":  # the head's own rigid fit places and turns it
-            given = {i: self._rigid(f, i) for i in chain.tips}
-        base0, head0 = self._inherit(f, chain.steps[0])
-        keep = f.ok[chain.points] if len(chain.points) else np.zeros(0, bool)
-        b = f.p[chain.points[keep]] - head0
-        wt = f.w[chain.points[keep]]
-        a = chain.offsets[keep] @ base0.T
-        turn = None
-        if len(b) >= 2:
-            turn = rot.kabsch(a, b, wt)
+    def _solve_chain(self, f: _Frame, c: _Chain) -> None:
+        """One turn shared along the chain (bone k of n takes (k+1)/n of it), fitted to the
+        chain's keypoints, then refined twice for the points the shared bend moves."""
+        base0, head0 = self._inherit(f, c.steps[0])
+        keep = [j for j, k in enumerate(c.points) if f.ok[k]]
+        b = [rot.sub(f.p[c.points[j]], head0) for j in keep]
+        wt = [f.w[c.points[j]] for j in keep]
+        a = [rot.apply(base0, c.offsets[j]) for j in keep]
+        turn = rot.kabsch(a, b, wt) if len(b) >= 2 else None
         if turn is None and len(b) >= 1:
-            turn = rot.between(wt @ a, wt @ b)
+            turn = rot.arc(rot.weighted_sum(a, wt), rot.weighted_sum(b, wt))
         if turn is None:
-            for i in chain.steps:
+            for i in c.steps:
                 base, f.heads[i] = self._inherit(f, i)
                 self._finish(f, i, base, None)
             return
-        at_rest = base0 @ chain.rest_rel  # (n, 3, 3) the chain's bones at rest
-        fractions = np.arange(1, len(chain.steps) + 1) / len(chain.steps)
-        for attempt in range(3):  # the shared bend moves the points: fit the residual turn
+        levers, fixed = self._chain_levers(f, c, base0, keep)
+        hops = [rot.apply(base0, h) for h in c.hops]
+        for _ in range(2):  # the shared bend moves the points: fit the residual turn
             axis, angle = rot.log(turn)
-            world = rot.turns_about(axis, angle * fractions) @ at_rest
-            if attempt == 2:
-                break  # a fix found now would not be applied
-            got = self._chain_points(f, chain, world, given)[keep] - head0
-            fix = rot.kabsch(got, b, wt) if len(b) >= 2 else rot.between(wt @ got, wt @ b)
-            if fix is None or rot.angle_of(fix) < 1e-5:
+            got = self._chain_points(c, keep, axis, angle, hops, levers, fixed)
+            fix = (rot.kabsch(got, b, wt) if len(b) >= 2
+                   else rot.arc(rot.weighted_sum(got, wt), rot.weighted_sum(b, wt)))  # fmt: skip
+            if fix is None or rot.angle(fix) < 1e-5:
                 break
-            turn = fix @ turn
-        self._place_chain(f, chain, world)
+            turn = rot.mul(fix, turn)
+        axis, angle = rot.log(turn)
+        self._place_chain(f, c, base0, head0, axis, angle)
 
-    def _place_chain(self, f: _Frame, chain, world: np.ndarray) -> None:
-        """Pose a chain's bones at world rotations (n, 3, 3), each relative to the one
-        before; bone by bone (``_finish``) only where a joint limit bites."""
-        ids, anchor = chain.steps, chain.anchor
-        above = np.concatenate([f.world[anchor][None], world[:-1]])
-        base = above @ chain.rel
-        local = base.transpose(0, 2, 1) @ world
-        if self.settings.limits and (rot.angle_many(local) > chain.limit).any():
-            for k, i in enumerate(chain.steps):
+    def _chain_levers(self, f: _Frame, c: _Chain, base0: rot.M, keep: list[int]):
+        """Per kept point, the vector its carrier's turn moves (world axes, at rest) and a
+        fixed part (the neck's head posed by its own rigid fit: not turned by the chain)."""
+        given: dict[int, rot.M | None] = {}
+        if c.name == "neck_chain":  # the head's own rigid fit places and turns it
+            given = {r: self._rigid(f, i) for r, i in enumerate(c.tip_ids)}
+        levers, fixed = [], []
+        for j in keep:
+            r = c.tip[j]
+            if r < 0:
+                levers.append(rot.apply(base0, c.lever[j]))
+                fixed.append(rot.ZERO)
+                continue
+            tip, _, tip_head, tip_rest = c.tips[r]
+            g = given.get(r)
+            if g is None:  # the tip in its latest pose relative to the chain
+                pose = rot.mul(tip_rest, self._last[tip])
+                levers.append(rot.apply(base0, rot.add(tip_head, rot.apply(pose, c.lever[j]))))
+                fixed.append(rot.ZERO)
+            else:
+                levers.append(rot.apply(base0, tip_head))
+                fixed.append(rot.apply(g, c.lever[j]))
+        return levers, fixed
+
+    def _chain_points(self, c: _Chain, keep, axis, angle, hops, levers, fixed) -> list[rot.V]:
+        """The kept keypoints relative to the chain's first head, with the chain's bones
+        turned by ``angle`` * (k+1)/n about ``axis``."""
+        n = len(c.steps)
+        needed = max(c.carrier[j] for j in keep)
+        trig = [(math.cos(angle * ((k + 1) / n)), math.sin(angle * ((k + 1) / n)))
+                for k in range(needed + 1)]  # fmt: skip
+        heads = [rot.ZERO]
+        for k in range(1, needed + 1):
+            cos_k, sin_k = trig[k - 1]
+            heads.append(rot.add(heads[-1], rot.rotate(axis, cos_k, sin_k, hops[k])))
+        out = []
+        for j, lever, extra in zip(keep, levers, fixed, strict=True):
+            k = c.carrier[j]
+            moved = rot.rotate(axis, trig[k][0], trig[k][1], lever)
+            h = heads[k]
+            out.append((h[0] + moved[0] + extra[0], h[1] + moved[1] + extra[1],
+                        h[2] + moved[2] + extra[2]))  # fmt: skip
+        return out
+
+    def _place_chain(self, f: _Frame, c: _Chain, base0: rot.M, head0: rot.V, axis: rot.V,
+                     angle: float) -> None:  # fmt: skip
+        """Pose the chain's bones: bone k of n turned by angle * (k+1)/n about ``axis`` from
+        its rest pose on the chain's base; bone by bone (``_finish``) where a joint limit
+        bites. Relative to the bone before, each is turned by angle / n about that axis as
+        its own rest frame sees it (rest frames are rigid), which gives its local rotation
+        without a product of the posed frames."""
+        n = len(c.steps)
+        world, local, heads = [], [], [head0]
+        bites = False
+        for k in range(n):
+            at_rest = rot.mul(base0, c.rest_rel[k])
+            world.append(rot.mul(rot.turn(axis, angle * ((k + 1) / n)), at_rest))
+            own = rot.turn(rot.tapply(at_rest, axis), angle * ((k + 1) / n) - angle * (k / n))
+            local.append(own)
+            bites = bites or (self.settings.limits and rot.angle(own) > c.limits[k])
+            if k:
+                step = self._bone[c.steps[k]].step
+                heads.append(rot.add(heads[-1], rot.apply(world[k - 1], step)))
+        if bites:
+            for k, i in enumerate(c.steps):
                 base_k, f.heads[i] = self._inherit(f, i)
-                self._finish(f, i, base_k, world[k])
+                self._finish(f, i, base_k, rot.tmul(base_k, world[k]))
             return
-        f.heads[ids] = f.heads[anchor] + np.cumsum((above @ chain.step[:, :, None])[:, :, 0], 0)
-        self._last[ids] = local
-        f.solved[ids] = True
-        f.local[ids] = local
-        f.world[ids] = base @ local
+        for k, i in enumerate(c.steps):
+            f.heads[i] = heads[k]
+            self._last[i] = f.local[i] = local[k]
+            f.solved[i] = True
+            f.world[i] = world[k]
 
-    def _rigid(self, f: _Frame, i: int) -> np.ndarray | None:
+    def _rigid(self, f: _Frame, i: int) -> rot.M | None:
         """World rotation of bone i from a rigid fit (rotation and translation) of its own
         keypoints, or None when they do not fix one."""
-        st = self.plan.steps[i]
-        keep = f.ok[st.points]
-        if keep.sum() < 3:
+        b = self._bone[i]
+        keep = [r for r, k in enumerate(b.points) if f.ok[k]]
+        if len(keep) < 3:
             return None
-        a, b, wt = st.offsets[keep], f.p[st.points[keep]], f.w[st.points[keep]]
-        return rot.kabsch(a - (wt @ a) / wt.sum(), b - (wt @ b) / wt.sum(), wt)
+        a = [b.offsets[r] for r in keep]
+        q = [f.p[b.points[r]] for r in keep]
+        wt = [f.w[b.points[r]] for r in keep]
+        total = sum(wt)
+        ca = _scaled(rot.weighted_sum(a, wt), 1 / total)
+        cb = _scaled(rot.weighted_sum(q, wt), 1 / total)
+        return rot.kabsch([rot.sub(v, ca) for v in a], [rot.sub(v, cb) for v in q], wt)
 
-    def _chain_points(self, f: _Frame, chain, world: np.ndarray, given: dict) -> np.ndarray:
-        """(n, 3) the chain's keypoints with its bones at world rotations (c, 3, 3); the
-        bones hanging on it (``chain.tips``) in their latest pose relative to it, or at
-        the world rotation ``given`` maps them to (None: the latest)."""
-        above = np.concatenate([f.world[chain.anchor][None], world[:-1]])
-        heads = f.heads[chain.anchor] + np.cumsum((above @ chain.step[:, :, None])[:, :, 0], 0)
-        if chain.tips:
-            tips, on = chain.tip_batch, chain.tip_on
-            wa = world[on]
-            tip_world = wa @ tips.rel @ self._last[tips.steps]
-            for r, i in enumerate(chain.tips):
-                if given.get(i) is not None:
-                    tip_world[r] = given[i]
-            tip_heads = heads[on] + (wa @ tips.step[:, :, None])[:, :, 0]
-            world = np.concatenate([world, tip_world])
-            heads = np.concatenate([heads, tip_heads])
-        own = chain.owner
-        return heads[own] + (world[own] @ chain.owner_offsets[:, :, None])[:, :, 0]
+    # -- single bones ---------------------------------------------------------------------
 
-    # -- single bones, a level at a time ---------------------------------------------------
+    def _solve_bone(self, f: _Frame, i: int) -> None:
+        """Swing (and twist) a bone onto its keypoints: a rigid turn where two or more
+        points fix one, else the shortest arc onto their weighted direction, twisted into
+        the limb's plane for upper arms and thighs. Solved in the bone's rest frame on its
+        anchor (``base``): the same turn as in the world, conjugated, one product fewer."""
+        b = self._bone[i]
+        wa = f.world[b.anchor]
+        base = rot.mul(wa, b.rel)
+        head = f.heads[i] = rot.add(f.heads[b.anchor], rot.apply(wa, b.step))
+        ok, p = f.ok, f.p
+        keep = [r for r, k in enumerate(b.points) if ok[k]]
+        if not keep:
+            self._finish(f, i, base, None)
+            return
+        origin = p[b.origin] if b.origin >= 0 and ok[b.origin] else head
+        seen = [rot.sub(p[b.points[r]], origin) for r in keep]  # world, from the joint
+        wt = [f.w[b.points[r]] for r in keep]
+        rest = [b.offsets[r] for r in keep]
+        local = None
+        if len(keep) >= 2:
+            local = rot.kabsch(rest, [rot.tapply(base, v) for v in seen], wt)
+        if local is None:
+            along = rot.weighted_sum(seen, wt)
+            local = _arc_in(base, rot.weighted_sum(rest, wt), along)
+            if b.pole is not None:
+                local = self._twist(f, b, base, local, along)
+        self._finish(f, i, base, local)
 
-    def _solve_bones(self, f: _Frame, batch: Batch) -> None:
-        """Swing (and twist) each bone of a batch onto its keypoints, all at once: a rigid
-        turn where two or more points fix one, else the shortest arc onto their weighted
-        direction, twisted into the limb's plane for upper arms and thighs."""
-        wa = f.world[batch.anchor]
-        base = wa @ batch.rel
-        f.heads[batch.steps] = head = f.heads[batch.anchor] + (wa @ batch.step[:, :, None])[:, :, 0]
-        keep = f.ok[batch.points] & batch.real
-        count = keep.sum(1)
-        has_origin = batch.origin >= 0
-        has_origin[has_origin] = f.ok[batch.origin[has_origin]]
-        origin = np.where(has_origin[:, None], f.p[batch.origin], head)
-        b = np.where(keep[:, :, None], f.p[batch.points] - origin[:, None, :], 0.0)
-        a = batch.offsets @ base.transpose(0, 2, 1)
-        wt = np.where(keep, f.w[batch.points], 0.0)
-        world = base.copy()
-        arc = count >= 1
-        many = count >= 2
-        if many.any():
-            turn, fixed = rot.kabsch_many(a[many], b[many], wt[many])
-            rows = np.flatnonzero(many)
-            world[rows[fixed]] = turn[fixed] @ base[rows[fixed]]
-            arc[rows[fixed]] = False
-        if arc.any():
-            along = (wt[arc, :, None] * b[arc]).sum(1)
-            turned = rot.between_many((wt[arc, :, None] * a[arc]).sum(1), along) @ base[arc]
-            twist = batch.has_pole[arc]
-            if twist.any():
-                rows = np.flatnonzero(arc)[twist]
-                turned[twist] = self._twist(f, batch, rows, turned[twist], along[twist])
-            world[arc] = turned
-        self._finish_many(f, batch, base, world, count >= 1)
-
-    def _twist(self, f: _Frame, batch: Batch, rows: np.ndarray, world: np.ndarray,
-               along: np.ndarray) -> np.ndarray:  # fmt: skip
-        """Turn limbs' upper bones (``rows`` of the batch, world (r, 3, 3), aimed along
-        (r, 3)) about their own axes so each bend axis lies along the normal of the
-        observed plane of the limb's three joints (weighted by how bent the limb is: a
-        straight limb keeps the swing's twist)."""
-        origin, mid, far = batch.origin[rows], batch.pole_mid[rows], batch.pole_far[rows]
-        seen = (origin >= 0) & f.ok[origin] & f.ok[mid] & f.ok[far]
-        upper, lower = f.p[mid] - f.p[origin], f.p[far] - f.p[mid]
-        normal = rot.cross_many(upper, lower)
-        with np.errstate(invalid="ignore"):
-            bend = np.sqrt((normal * normal).sum(1)) / (
-                np.sqrt((upper * upper).sum(1) * (lower * lower).sum(1)) + 1e-12)
-        weight = np.clip((bend - 0.05) / 0.15, 0.0, 1.0)  # sin of the bend: 3..11 degrees
-        weight = np.where(seen, weight, 0.0)
-        length = np.sqrt((along * along).sum(1))[:, None]
-        d = np.where(length > 1e-12, along / np.where(length > 1e-12, length, 1.0), along)
-        have = (world @ batch.pole_axis[rows][:, :, None])[:, :, 0]
-        have = have - d * (have * d).sum(1)[:, None]
-        want = normal - d * (normal * d).sum(1)[:, None]
-        live = (weight > 0) & ((have * have).sum(1) >= 1e-12) & ((want * want).sum(1) >= 1e-12)
-        if not live.any():
-            return world
-        angle = np.arctan2((rot.cross_many(have, want) * d).sum(1), (have * want).sum(1))
-        angle = np.where(live, weight * angle, 0.0)
-        return rot.axis_angle_many(np.nan_to_num(d), np.nan_to_num(angle)) @ world
+    def _twist(self, f: _Frame, b: _Bone, base: rot.M, local: rot.M, along: rot.V) -> rot.M:
+        """Turn a limb's upper bone about its own axis so its bend axis lies along the
+        normal of the observed plane of the limb's three joints (weighted by how bent the
+        limb is: a straight limb keeps the swing's twist). In the base frame."""
+        assert b.pole is not None
+        mid, far, pole_axis = b.pole
+        ok, p = f.ok, f.p
+        if not (b.origin >= 0 and ok[b.origin] and ok[mid] and ok[far]):
+            return local
+        upper, lower = rot.sub(p[mid], p[b.origin]), rot.sub(p[far], p[mid])
+        normal = rot.cross(upper, lower)
+        bend = math.sqrt(rot.dot(normal, normal)) / (
+            math.sqrt(rot.dot(upper, upper) * rot.dot(lower, lower)) + 1e-12
+        )
+        weight = min(max((bend - 0.05) / 0.15, 0.0), 1.0)  # sin of the bend: 3..11 degrees
+        if not weight > 0:
+            return local
+        d = rot.unit(rot.tapply(base, along))
+        have = rot.apply(local, pole_axis)
+        have = rot.sub(have, _scaled(d, rot.dot(have, d)))
+        want = rot.tapply(base, normal)
+        want = rot.sub(want, _scaled(d, rot.dot(want, d)))
+        if rot.dot(have, have) < 1e-12 or rot.dot(want, want) < 1e-12:
+            return local
+        angle = math.atan2(rot.dot(rot.cross(have, want), d), rot.dot(have, want))
+        return rot.mul(rot.turn(d, weight * angle), local)
 
     # -- output ----------------------------------------------------------------------------
 
     def _output(self, f: _Frame, t: float, contacts: np.ndarray) -> SolvedFrame:
-        sk = self.rig.skeleton
-        count = len(sk.names)
-        rotations = np.zeros((count, 4))
-        rotations[:, 0] = 1.0
-        rotations[self._bones] = rot.quaternions(f.local)
-        translations = np.zeros((count, 3))
-        translations[self._hips] = self._rest[self._hips].T @ (f.heads[0] - sk.heads[self._hips])
+        rotations = self._identity.copy()
+        rotations[self._bones] = rot.quaternions(np.array(f.local))
+        translations = np.zeros((len(self._identity), 3))
+        translations[self._hips] = rot.tapply(self._hips_rest, rot.sub(f.heads[0], self._hips_head))
         points = np.full((len(self.rig.keypoints.names), 3), np.nan)
-        own, off = self._point_owner, self._point_offsets
-        points[self._point_ids] = f.heads[own] + (f.world[own] @ off[:, :, None])[:, :, 0]
-        return SolvedFrame(rotations, translations, points, t, f.solved.copy(), contacts)
+        own = self._point_owner
+        world = np.array(f.world).reshape(-1, 3, 3)[own]
+        points[self._point_ids] = np.array(f.heads)[own] + (world @ self._point_offsets)[:, :, 0]
+        return SolvedFrame(rotations, translations, points, t, np.array(f.solved), contacts)
 
 
-@dataclass
+def _length(v: Sequence[float]) -> float:
+    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+
+
+def _scaled(v: Sequence[float], s: float) -> rot.V:
+    return (v[0] * s, v[1] * s, v[2] * s)
+
+
+def _arc_in(base: rot.M, rest: rot.V, along: rot.V) -> rot.M:
+    """The shortest arc taking the world direction ``base @ rest`` onto ``along``, as a turn
+    in the frame ``base`` (``base.T @ arc @ base``). When the two are parallel or either is
+    zero the arc is the identity or a half turn whose axis depends on the frame: that rare
+    case is computed in world axes, as before, and brought into the frame."""
+    mine = rot.tapply(base, along)
+    c = rot.cross(rot.unit(rest), rot.unit(mine))
+    if rot.dot(c, c) >= 1e-17:
+        return rot.arc(rest, mine)
+    world = rot.arc(rot.apply(base, rest), along)
+    return rot.tmul(base, rot.mul(world, base))
+
+
+@dataclass(slots=True)
 class _Frame:
-    """One frame's working state: keypoints (K, 3), ok (K,), weights (K,), and per solved
-    bone world rotations (S, 3, 3), heads (S, 3), local rotations (S, 3, 3), solved (S,)."""
+    """One frame's working state: keypoints (K) as 3-sequences, ok (K) bools, weights (K),
+    and per solved bone (S, in the plan's order) world rotations and local rotations (9-
+    tuples, row-major), heads (3-tuples, metres) and solved flags."""
 
-    p: np.ndarray
-    ok: np.ndarray
-    w: np.ndarray
-    world: np.ndarray
-    heads: np.ndarray
-    local: np.ndarray
-    solved: np.ndarray
+    p: list
+    ok: list
+    w: list
+    world: list
+    heads: list
+    local: list
+    solved: list
     decay: float
 
 
