@@ -80,9 +80,19 @@ class PointFilter:
             return points
         seen = np.isfinite(points).all(axis=1)
         fresh = seen & ((t - self.t > p.reset_after) | ~np.isfinite(self.x).all(axis=1))
-        self.x[fresh], self.dx[fresh], self.t[fresh] = points[fresh], 0.0, t
-        self.raw[fresh] = points[fresh]
+        if fresh.any():
+            self.x[fresh], self.dx[fresh], self.t[fresh] = points[fresh], 0.0, t
+            self.raw[fresh] = points[fresh]
         go = seen & ~fresh & (t > self.t)
+        if go.all():  # the usual frame: every point seen and moving on; no masks needed
+            dt = (t - self.t)[:, None]
+            raw = (points - self.raw) / dt
+            self.dx += _alpha(p.d_cutoff, dt) * (raw - self.dx)
+            speed = np.linalg.norm(self.dx, axis=1, keepdims=True)
+            self.x += _alpha(p.min_cutoff + p.beta * speed, dt) * (points - self.x)
+            self.raw[:] = points
+            self.t[:] = t
+            return self.x.copy()
         if np.any(go):
             dt = (t - self.t[go])[:, None]
             raw = (points[go] - self.raw[go]) / dt
