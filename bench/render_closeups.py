@@ -3,6 +3,8 @@ brows, hair and shoes by eye.
 
     python bench/render_closeups.py heads [--samples 12] [--out docs/images] [--views front,back]
     python bench/render_closeups.py feet
+    python bench/render_closeups.py legs [--walk] [--views front,back,side]   # bottoms
+    python bench/render_closeups.py tops [--walk]                             # cap, hood, dress
 
 Needs the pip ``bpy`` module. Heads: front, three-quarter and back, the mouth open
 (``expression/jawOpen``) on two of them so teeth and tongue show. Feet: five bodies' shoes.
@@ -35,6 +37,22 @@ SETS["feet"] = [
     ({"gender": 0.0, "age": 0.9, "weight": 0.9}, ("shoes", "skirt")),
     ({"gender": 1.0, "age": 1.0}, ("socks", "shoes", "trousers")),
 ]  # fmt: skip
+SETS["legs"] = [  # jeans, trousers, skirt, dress on four bodies, waist to floor
+    ({"gender": 0.0, "age": 0.45}, ("jeans", "sneakers")),
+    ({"gender": 1.0, "age": 0.5, "weight": 0.7}, ("jeans", "boots")),
+    ({"gender": 1.0, "age": 0.9}, ("trousers", "shoes-black")),
+    ({"gender": 0.0, "age": 0.6, "weight": 0.9}, ("tanktop", "skirt", "shoes")),
+    ({"gender": 0.0, "age": 0.3}, ("dress", "shoes-black")),
+]  # fmt: skip
+SETS["tops"] = [  # cap and hood from the shoulders up
+    ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short", "tshirt", "cap")),
+    ({"gender": 1.0, "age": 0.3, "muscle": 0.8}, ("eyebrows", "eyelashes", "hair-buzz", "hoodie")),
+    ({"gender": 0.0, "age": 0.12}, ("eyebrows", "eyelashes", "hair-bob", "hoodie", "cap")),
+    ({"gender": 0.0, "age": 0.4}, ("eyebrows", "eyelashes", "hair-long", "dress")),
+]  # fmt: skip
+CROWN_AIM = 1.8 - 0.32  # tops: crowns put at 1.8 m (as heads), the camera on the shoulders
+# set -> (metres between bodies, frame height / width per body, aim height (m))
+FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM)}
 # Per set: where the camera looks (z of the aim point relative to the aligned height, m),
 # and the views (name -> direction from subject to camera).
 VIEWS = {
@@ -50,27 +68,29 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=12)
     parser.add_argument("--out", default="docs/images")
     parser.add_argument("--name", default="closeup")
-    parser.add_argument("--texture", type=int, default=1024)
     parser.add_argument("--size", type=int, default=260, help="pixels per head (square)")
+    parser.add_argument("--walk", action="store_true", help="mid-stride in the built-in walk")
     args = parser.parse_args()
     from avatar.blender import render, scene
-    from avatar.clothes.library import dress, load_garment, parts
     from avatar.human import Human
 
     out = Path(args.out)
     chars = []
     chosen = SETS[args.set]
     heads = args.set == "heads"
+    spacing, tall, aim = FRAMING.get(args.set, (SPACING if heads else 0.55, 1.0, None))
     for i, (params, names) in enumerate(chosen):
-        human = Human(params)
-        outfit = dress(human.body, [load_garment(n, texture_size=args.texture) for n in names])
-        top = float(human.vertices[:13380, 2].max()) if heads else 0.0
+        human = Human(params).dressed(*names)  # stands on its shoes' soles
+        outfit = human.outfit  # exact, as exports have it; its parts come last in parts()
+        crowns = heads or args.set == "tops"
+        top = float(human.vertices[:13380, 2].max()) if crowns else 0.0
         # Side by side, crowns (or soles) at one height, so one camera frames them all.
-        spacing = SPACING if heads else 0.55
-        location = ((i - (len(chosen) - 1) / 2) * spacing, 0.0, CROWN - top if heads else 0.0)
-        chars.append(scene.Character(f"head{i}", human.parts() + parts(outfit), human.skeleton,
-                                     location=location))  # fmt: skip
-    size = (args.size * len(chars), args.size)
+        location = ((i - (len(chosen) - 1) / 2) * spacing, 0.0, CROWN - top if crowns else 0.0)
+        shown = human.parts()
+        if args.walk:
+            shown = _mid_stride(human, outfit, shown)
+        chars.append(scene.Character(f"head{i}", shown, human.skeleton, location=location))
+    size = (args.size * len(chars), int(args.size * tall))
     for view in args.views.split(","):
         direction = VIEWS[view]
         scene.clear_scene()
@@ -79,10 +99,32 @@ def main() -> None:
         scene.add_lights()
         if not heads:
             scene.add_floor()
-        _aim(direction, spacing * len(chosen), size, CROWN - 0.14 if heads else 0.07)
-        path = render.render(out / f"{args.name}_{args.set}_{view}.png", samples=args.samples,
+        height = aim if aim is not None else (CROWN - 0.14 if heads else 0.07)
+        _aim(direction, spacing * len(chosen), size, height)
+        stem = f"{args.name}_{args.set}{'_walk' if args.walk else ''}_{view}"
+        path = render.render(out / f"{stem}.png", samples=args.samples,
                              resolution=size)  # fmt: skip
         print(path)
+
+
+def _mid_stride(human, outfit, rest_parts):
+    """The parts posed a quarter into the built-in walk (legs apart), garments resolved for
+    the frame (exact), walking in place."""
+    from avatar.part import MeshPart
+    from avatar.rig import kinematics, skinning
+
+    walk = human.walk(seconds=1.0, fps=24)
+    world = kinematics.forward(human.skeleton, walk.rotations[6:7], walk.translations[6:7])
+    matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
+    body = skinning.linear_blend(human.vertices, human.weights, matrices)
+    garments = outfit.frame(body, matrices, exact=True)
+    shift = np.zeros(3, np.float32)
+    shift[:2] = (body[:13380] - human.vertices[:13380]).mean(axis=0)[:2]
+    count = len(rest_parts) - len(garments)
+    out = [MeshPart(p.name, p.mesh.with_vertices(body[human.part_vertices(p.name)] - shift),
+                    p.material) for p in rest_parts[:count]]  # fmt: skip
+    return out + [MeshPart(p.name, p.mesh.with_vertices(v - shift), p.material)
+                  for p, v in zip(rest_parts[count:], garments, strict=True)]  # fmt: skip
 
 
 SPACING, CROWN = 0.36, 1.8  # metres between heads; where every crown is put

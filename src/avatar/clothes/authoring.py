@@ -21,6 +21,7 @@ from avatar.clothes.binder import bind
 from avatar.clothes.binding import Binding, make_binding
 from avatar.geometry.shell import boundary_edges
 from avatar.looks.fabrics import TILE_METRES
+from avatar.looks.tailored import Layout
 from avatar.mesh import Mesh, vertex_normals
 
 
@@ -60,10 +61,15 @@ class AuthoringBody:
 
 @dataclass(frozen=True)
 class Piece:
-    """Garment geometry on the authoring body, bound to the surface it came from."""
+    """Garment geometry on the authoring body, bound to the surface it came from.
+
+    layout: what to paint on a tailored garment's own texture (``looks.tailored``); None
+    for garments textured with a tiling fabric.
+    """
 
     mesh: Mesh
     binding: Binding
+    layout: Layout | None = None
 
 
 def cut(
@@ -271,7 +277,8 @@ def join(pieces: list[Piece]) -> Piece:
         b[0].scale_lengths,
         np.concatenate([x.single for x in b]),
     )
-    return Piece(mesh, binding)
+    layout = next((p.layout for p in pieces if p.layout is not None), None)
+    return Piece(mesh, binding, layout)
 
 
 def _pad(a: np.ndarray, width: int) -> np.ndarray:
@@ -287,10 +294,12 @@ def covered_skin(body: AuthoringBody, mesh: Mesh, reach: float = 0.02) -> np.nda
     return np.flatnonzero(np.isfinite(d)).astype(np.int32)
 
 
-def banded(mesh: Mesh, width: float = 0.015, lift: float = 0.0015) -> Mesh:
+def banded(mesh: Mesh, width=0.015, lift: float = 0.0015) -> Mesh:
     """The mesh with a band along every open edge (neckline rib, hem, cuffs): the faces
     within ``width`` m of an edge again, ``lift`` m further out, and a lip joining the edge
     to the band's, so the edge has a thickness and the band stands proud of the cloth.
+    width: metres, or a callable (R, 3) edge points -> (R,) metres (a waistband wider than
+    the hems).
 
     mesh: an outward-facing garment surface with per-corner UVs (``with_box_uvs``); the
     band's faces keep the UVs of the faces they copy. Returns a new Mesh.
@@ -301,8 +310,9 @@ def banded(mesh: Mesh, width: float = 0.015, lift: float = 0.0015) -> Mesh:
         return mesh
     v = mesh.vertices.astype(np.float64)
     rim = np.unique(edges)
-    near, _ = cKDTree(v[rim]).query(v)
-    inside = near < width
+    near, which = cKDTree(v[rim]).query(v)
+    widths = np.asarray(width(v[rim]) if callable(width) else np.full(len(rim), width))
+    inside = near < widths[which]
     band = np.flatnonzero(inside[mesh.faces].all(axis=1))
     normals = vertex_normals(mesh.vertices, mesh.faces).astype(np.float64)
     n = len(v)

@@ -9,11 +9,11 @@ MakeHuman base mesh Avatar already needs, the textures from ``fabrics``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from avatar.clothes import face, hair, shoes
+from avatar.clothes import face, hair, headwear, shoes, tailoring
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -22,11 +22,13 @@ from avatar.clothes.authoring import (
     covered_skin,
     cut,
     join,
+    with_box_uvs,
 )
 from avatar.clothes.fitting import Garment
 from avatar.clothes.regions import face_features
-from avatar.looks import fabrics, facial_hair, textures
+from avatar.looks import fabrics, facial_hair, tailored, textures
 from avatar.material import Material
+from avatar.mesh import Mesh
 
 RELAX = 12  # smoothing passes over cut edges (hems, armholes, necklines)
 
@@ -59,10 +61,45 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0) -> Piece:
     return bound(body, mesh, faces)
 
 
-def _skirt(body: AuthoringBody, bottom_z: float, ease) -> Piece:
+def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False) -> Piece:
+    """A skirt from ``helper-skirt`` down to ``bottom_z``, swinging as one (``blend_sides``);
+    ``tailor``: its own panel texture with side seams, a waistband (geometry too), a
+    centre-back zip and a stitched hem band."""
     faces = body.group_faces("helper-skirt")
     centre_z = body.vertices[faces].mean(axis=1)[:, 2]
-    return bound(body, cut(body, faces, centre_z > bottom_z, ease, RELAX, loose=True), faces)
+    mesh = cut(body, faces, centre_z > bottom_z, ease, RELAX, loose=True)
+    if not tailor:
+        return tailoring.blend_sides(body, bound(body, mesh, faces), "helper-skirt")
+    panels = tailoring.Panels(mesh, tailoring.SKIRT_PANELS, tailoring.body_axis(body.marks))
+    h = tailoring.heights(mesh, body.marks, 0.035)
+    top = h.top
+    mesh = banded(panels.textured(), lambda p: np.where(p[:, 2] > top - 0.05, 0.035, 0.02),
+                  0.0015)  # fmt: skip
+    layout = tailoring.layout(panels, tailoring.skirt_marks(panels, h), "red")
+    piece = replace(bound(body, mesh, faces), layout=layout)
+    return tailoring.blend_sides(body, piece, "helper-skirt")
+
+
+def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
+              thread: str) -> Piece:  # fmt: skip
+    """Jeans or trousers: cut from ``helper-tights`` to ``length`` along the leg, falling
+    straight from the knee (``hang`` x the knee's radius), unrolled into four panels
+    painted with ``kind``'s construction (``tailoring``), a raised waistband and hem bands,
+    and belt loops."""
+    faces = body.group_faces("helper-tights")
+    ff = face_features(body.vertices, faces, body.part, body.marks)
+    mesh = cut(body, faces, bottom(length)(ff, body.marks), ease, relax=RELAX)
+    mesh = Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang)
+                .astype(np.float32), mesh.faces)  # fmt: skip
+    panels = tailoring.Panels(mesh, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
+    band = 0.04 if kind == "jeans" else 0.035
+    h = tailoring.heights(mesh, body.marks, band)
+    top = h.top
+    mesh = banded(panels.textured(), lambda p: np.where(p[:, 2] > top - 0.05, band, 0.02),
+                  0.002)  # fmt: skip
+    marks = (tailoring.jeans_marks if kind == "jeans" else tailoring.trouser_marks)(panels, h)
+    piece = join([bound(body, mesh, faces), tailoring.belt_loops(body, mesh, h, faces)])
+    return replace(piece, layout=tailoring.layout(panels, marks, thread))
 
 
 def _z(ff):
@@ -164,32 +201,106 @@ dress_bodice = strapped(0.02, armhole=0.056, front=0.09, back=0.07)
 
 
 def _dress(body: AuthoringBody) -> Piece:
-    top_piece = _tights(body, dress_bodice, 0.004, 0.012)
-    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.004, 0.05))
-    return join([top_piece, skirt_piece])
+    """Bodice on straps and a skirt, one garment. The bodice's waist edge has no band (it
+    ran as a ridge round the waist) and tucks under the skirt's top; the skirt swings as
+    one (``tailoring.blend_sides``), so it neither splits nor bells between the legs."""
+    faces = body.group_faces("helper-tights")
+    ff = face_features(body.vertices, faces, body.part, body.marks)
+    bodice = cut(body, faces, dress_bodice(ff, body.marks), 0.004, relax=RELAX)
+    waist = float(np.percentile(bodice.vertices[:, 2], 1)) + 0.03
+    bodice = banded(bodice, lambda p: np.where(p[:, 2] > waist, 0.012, 0.0))
+    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.004, 0.04))
+    return join([bound(body, bodice, faces), skirt_piece])
 
 
 def _hood(body: AuthoringBody) -> Piece:
-    """A hood lying down on the back: the back of the neck and shoulders cut again and
-    puffed out into a soft roll (deepest in the middle), its rim banded."""
+    """A hood lying down on the back: from the neckline, a pouch that narrows to a rounded
+    point between the shoulder blades, flat in its middle and rolled up at its rim (the face
+    opening folded over), the rim banded so the cloth shows its thickness."""
     faces = body.group_faces("helper-tights")
     m = body.marks
     c = body.vertices[faces].mean(axis=1)
-    low, high = m.neck[2] - 0.2, m.neck[2] + 0.035
+    low, high = m.neck[2] - 0.24, m.neck[2] + 0.035
+    depth = np.clip((high - c[:, 2]) / (high - low), 0, 1)  # 0 at the neck, 1 at the tip
+    half = 0.15 * np.sqrt(np.clip(1 - depth**2.2, 0, 1)) + 0.01  # a rounded point below
     keep = (c[:, 1] > m.neck[1] - 0.01) & (c[:, 2] > low) & (c[:, 2] < high)
-    keep &= np.abs(c[:, 0]) < 0.14
+    keep &= np.abs(c[:, 0]) < half
 
     def puff(p, arm, leg):
-        across = np.clip(1 - (p[:, 0] / 0.14) ** 2, 0, 1)
-        down = np.sin(np.pi * np.clip((p[:, 2] - low) / (high - low), 0, 1)) ** 0.7
-        return 0.012 + 0.035 * across * down
+        d = np.clip((high - p[:, 2]) / (high - low), 0, 1)
+        edge = np.abs(p[:, 0]) / (0.15 * np.sqrt(np.clip(1 - d**2.2, 0, 1)) + 0.01)
+        rim = np.exp(-(((1 - np.clip(edge, 0, 1)) / 0.22) ** 2))  # the rolled opening
+        pouch = np.sin(np.pi * np.clip(d, 0, 1)) ** 0.8  # the hood's bag lying on the back
+        return 0.01 + 0.018 * pouch + 0.02 * rim * np.clip(d * 3, 0, 1)
 
-    return bound(body, banded(cut(body, faces, keep, puff, relax=RELAX), 0.012), faces)
+    return bound(body, banded(cut(body, faces, keep, puff, relax=RELAX), 0.022, 0.003), faces)
+
+
+def _drawstrings(body: AuthoringBody, length: float = 0.2, radius: float = 0.0028) -> Piece:
+    """Two cords from either side of the hood's opening at the throat, hanging down the
+    chest 3 mm off the cloth, each a six-sided tube ending in a narrower aglet."""
+    m = body.marks
+    tubes = []
+    for side in (1, -1):
+        start = np.array([side * 0.03, m.neck[1], m.neck[2] - 0.02])
+        z = start[2] - np.linspace(0, length, 14)
+        x = side * (0.03 + 0.012 * np.linspace(0, 1, 14) ** 2)
+        # Lie on the chest: 2.4 cm (the hoodie's cloth and the cord) in front of the skin's
+        # frontmost point at each height.
+        skin = body.vertices[: len(body.part)]
+        skin = skin[skin[:, 1] < m.neck[1] + 0.03]
+        front = np.array([skin[(np.abs(skin[:, 0] - xi) < 0.012)
+                               & (np.abs(skin[:, 2] - zi) < 0.012), 1].min()
+                          for xi, zi in zip(x, z, strict=True)])  # fmt: skip
+        path = np.stack([x, front - 0.024, z], -1)
+        r = np.full(14, radius)
+        r[-3:] = radius * 0.75  # the aglet
+        a = np.linspace(0, 2 * np.pi, 6, endpoint=False)
+        ring = []
+        for k, p in enumerate(path):
+            t = path[min(k + 1, 13)] - path[max(k - 1, 0)]
+            t /= np.linalg.norm(t)
+            u = np.cross(t, [1.0, 0, 0])
+            u /= np.linalg.norm(u)
+            w = np.cross(t, u)
+            ring.append(p + r[k] * (np.cos(a)[:, None] * u + np.sin(a)[:, None] * w))
+        pts = np.concatenate(ring)
+        idx = np.arange(len(pts)).reshape(14, 6)
+        faces = [[idx[k, j], idx[k, (j + 1) % 6], idx[k + 1, (j + 1) % 6], idx[k + 1, j]]
+                 for k in range(13) for j in range(6)]  # fmt: skip
+        faces += [[idx[-1, 0], idx[-1, 1], idx[-1, 2], idx[-1, 3]],
+                  [idx[-1, 3], idx[-1, 4], idx[-1, 5], idx[-1, 0]]]  # fmt: skip
+        f = np.asarray(faces, np.int32)
+        mesh = Mesh(pts.astype(np.float32), f)
+        tubes.append(bound(body, with_box_uvs(_out_of(mesh, path)), body.group_faces(
+            "helper-tights")))  # fmt: skip
+    return join(tubes)
+
+
+def _out_of(mesh: Mesh, axis_points: np.ndarray) -> Mesh:
+    """A tube's faces turned away from its axis (nearest axis point)."""
+    v = mesh.vertices[mesh.faces].astype(np.float64)
+    n = np.cross(v[:, 2] - v[:, 0], v[:, 3] - v[:, 1])
+    mid = v.mean(axis=1)
+    nearest = axis_points[np.argmin(np.linalg.norm(mid[:, None] - axis_points[None], axis=2),
+                                    axis=1)]  # fmt: skip
+    flip = np.einsum("fd,fd->f", n, mid - nearest) < 0
+    faces = mesh.faces.copy()
+    faces[flip] = faces[flip][:, ::-1]
+    return Mesh(mesh.vertices, faces)
+
+
+def _kangaroo_pocket(ff, m):
+    """The hoodie's front pocket: a patch across the belly, above the hem band."""
+    x, y, z = ff.centre.T
+    return ((ff.part == "torso") & (y < m.neck[1] - 0.02) & (np.abs(x) < 0.115)
+            & (z > m.hip[0, 2] + 0.01) & (z < m.hip[0, 2] + 0.17))  # fmt: skip
 
 
 def _hoodie(body: AuthoringBody) -> Piece:
     top_piece = _tights(body, top(0.95, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012), 0.03)
-    return join([top_piece, _hood(body)])
+    pocket = _tights(body, _kangaroo_pocket, 0.017, 0.012)
+    return join([top_piece, pocket, _hood(body), _drawstrings(body)])
 
 
 def _skirt_ease(body: AuthoringBody, base: float, extra: float):
@@ -198,8 +309,7 @@ def _skirt_ease(body: AuthoringBody, base: float, extra: float):
 
 
 def _cap(body: AuthoringBody) -> Piece:
-    crown = hair.scalp(body, 0.014, front=0.045, side=0.035, back=0.0)
-    return join([crown, hair.brim(body, crown)])
+    return headwear.cap(body)
 
 
 EYELASH_GROUPS = (
@@ -217,11 +327,11 @@ SPECS = [
     Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
-    Spec("trousers", "bottoms", lambda b: _tights(b, bottom(0.97), flare(0.008, 0.025, 0.2)), "wool", "grey", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
-    Spec("jeans", "bottoms", lambda b: _tights(b, bottom(0.96), flare(0.005, 0.012, 0.3)), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
+    Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.08, "grey"), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
+    Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow"), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
     Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
-    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03)), "cotton", "red", 0.0015, 36, ("skirt",)),  # noqa: E501
+    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",)),  # noqa: E501
     Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
@@ -229,7 +339,7 @@ SPECS = [
     Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "black", "black", "charcoal")),  # noqa: E501
     Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", "white", "grey")),  # noqa: E501
     Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "black", "tan", "dark brown")),  # noqa: E501
-    Spec("cap", "headwear", _cap, "canvas", "red", 0.003, 80, ("cap", "hat", "baseball")),
+    Spec("cap", "headwear", _cap, "canvas", "red", 0.0, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 320, (0.08, 0.14), 0.025, (0.003, 0.008), 4), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
@@ -251,7 +361,11 @@ BY_NAME = {s.name: s for s in SPECS}
 def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
     """A built-in Garment from its recipe on the authoring body."""
     piece = spec.make(body)
-    if spec.look is not None:
+    if piece.layout is not None:
+        # A panel texture covers the whole garment once (not a tile): twice the texels.
+        material = tailored.material(spec.name, spec.fabric, spec.colour, piece.layout,
+                                     min(2 * texture_size, 4096))  # fmt: skip
+    elif spec.look is not None:
         material = spec.look(spec, texture_size)
     elif spec.category in ("hair", "face"):
         material = textures.hair_material(spec, texture_size)

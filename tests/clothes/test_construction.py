@@ -1,0 +1,263 @@
+"""Garment construction that must show: jeans, trousers, skirt, cap, hood, dress.
+
+Each test names what an artist would see wrong: jeans painted on like leggings, trousers
+that read as sweatpants, a skirt splitting between the legs, a stripy dome for a cap, a
+bulge for a hood, a dress with a ridge round the waist that bells out in a wide stance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar.clothes import builtin, headwear, library, tailoring
+from avatar.geometry.shell import boundary_edges
+from avatar.human import Human
+from avatar.looks import tailored
+from avatar.motion import procedural
+from avatar.rig import kinematics, quaternion, skinning
+
+
+@pytest.fixture(scope="module")
+def body():
+    return library.authoring_body()
+
+
+def _kinds(piece, kind: str) -> list:
+    return [m for m in piece.layout.marks if m.kind == kind]
+
+
+def _leg_radius(body, v, leg_at: float) -> float:
+    """Median distance from the left leg's axis of garment points near ``leg_at``."""
+    from avatar.clothes.regions import limb_coordinates
+
+    m = body.marks
+    _, leg = limb_coordinates(v.astype(np.float64), m)
+    near = (np.abs(leg - leg_at) < 0.03) & (v[:, 0] > 0.02)
+    axis = m.knee[0] + (m.ankle[0] - m.knee[0]) * (leg_at - 0.5) / 0.5
+    return float(np.median(np.hypot(v[near, 0] - axis[0], v[near, 1] - axis[1])))
+
+
+# ---------------------------------------------------------------------------- jeans
+
+
+def test_jeans_have_five_pockets_fly_yoke_rivets_and_felled_seams(body):
+    piece = builtin.BY_NAME["jeans"].make(body)
+    assert piece.layout is not None
+    assert len(_kinds(piece, "patch")) == 3  # two back pockets and the coin pocket
+    assert len(_kinds(piece, "edge")) >= 2 + 4  # front pocket scoops, hem folds
+    assert len(_kinds(piece, "rivet")) == 4 and len(_kinds(piece, "button")) == 1
+    assert len(_kinds(piece, "stitch")) > 30
+    seams = _kinds(piece, "seam")
+    assert seams[0].points.ndim == 3 and len(seams[0].points) > 50  # panel edges, both sides
+    assert len(_kinds(piece, "fold")) >= 8 and len(_kinds(piece, "wash")) >= 4
+
+
+def test_jeans_panels_cover_the_texture_once(body):
+    """Four charts side by side: no two panels overlap in UV (a unique, paintable layout)."""
+    jeans = builtin.BY_NAME["jeans"].make(body)
+    faces = body.group_faces("helper-tights")
+    ff = builtin.face_features(body.vertices, faces, body.part, body.marks)
+    raw = builtin.cut(body, faces, builtin.bottom(0.96)(ff, body.marks), 0.005)
+    panels = tailoring.Panels(raw, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
+    uv = panels.textured().uvs.reshape(len(raw.faces), -1, 2).mean(axis=1)
+    spans = [(uv[panels.face_panel == k, 0].min(), uv[panels.face_panel == k, 0].max())
+             for k in range(4)]  # fmt: skip
+    for left, right in zip(spans[:-1], spans[1:], strict=True):
+        assert left[1] < right[0]  # left to right, apart
+    assert uv.min() >= 0 and uv.max() <= 1
+    assert set(np.unique(panels.face_panel)) == {0, 1, 2, 3}
+    assert jeans.mesh.uvs.min() >= 0 and jeans.mesh.uvs.max() <= 1
+
+
+def test_jeans_have_a_raised_waistband_belt_loops_and_hem_bands(body):
+    mesh = builtin.BY_NAME["jeans"].make(body).mesh
+    v = mesh.vertices
+    top = np.percentile(v[:, 2], 99)
+    # Belt loops: little blocks standing off the band, all round the waist.
+    waist = v[v[:, 2] > top - 0.05]
+    centre = waist.mean(axis=0)
+    off = np.hypot(waist[:, 0] - centre[0], waist[:, 1] - centre[1])
+    angle = np.degrees(np.arctan2(waist[:, 0] - centre[0], -(waist[:, 1] - centre[1])))
+    proud = []
+    for a in (25, 80, 140, 180, -140, -80, -25):
+        d = np.abs((angle - a + 180) % 360 - 180)
+        ring = off[(d < 20)]
+        proud.append(np.percentile(ring, 99) - np.median(ring))
+    assert min(proud) > 0.002
+    # Hem bands: a lip closes each leg's edge (the cloth has a thickness there).
+    edges, _ = boundary_edges(mesh.faces)
+    assert len(edges) > 0
+    low = v[v[:, 2] < v[:, 2].min() + 0.03]
+    assert len(low) > 40
+
+
+def test_jeans_fall_straight_from_the_knee_and_trousers_are_looser(body):
+    jeans = builtin.BY_NAME["jeans"].make(body).mesh.vertices
+    trousers = builtin.BY_NAME["trousers"].make(body).mesh.vertices
+    leggings = builtin.BY_NAME["leggings"].make(body).mesh.vertices
+    for v, ratio in ((jeans, 0.95), (trousers, 1.0)):
+        assert _leg_radius(body, v, 0.9) > ratio * _leg_radius(body, v, 0.5)
+    # Leggings follow the calf and ankle; jeans do not.
+    assert _leg_radius(body, leggings, 0.9) < 0.8 * _leg_radius(body, leggings, 0.5)
+    assert _leg_radius(body, jeans, 0.9) > 1.3 * _leg_radius(body, leggings, 0.9)
+
+
+def test_seams_and_pockets_show_in_the_normal_map(body):
+    piece = builtin.BY_NAME["jeans"].make(body)
+    m = tailored.material("jeans", "denim", "indigo", piece.layout, 512)
+    assert m.normal_texture.shape == (512, 512, 3)
+    assert m.extras["tailored"]
+    normal = m.normal_texture.astype(float) / 127.5 - 1
+    tilt = np.hypot(normal[..., 0], normal[..., 1])
+    canvas = tailored.Canvas(512)
+    seam = _kinds(piece, "seam")[0].points
+    d, _, w = canvas.distance(seam, 3)
+    on_seam = tilt[w][d < 1.5].mean()
+    patch = _kinds(piece, "patch")[0].points
+    d, _, w = canvas.distance(patch, 3, closed=True)
+    on_patch_edge = tilt[w][d < 1.5].mean()
+    plain = np.median(tilt)
+    assert on_seam > 1.5 * plain and on_patch_edge > 1.5 * plain
+    # Stitches in the thread colour (gold on indigo): bright pixels along the stitch lines.
+    colour = m.base_color_texture.astype(float)
+    stitch = _kinds(piece, "stitch")[0].points
+    d, _, w = canvas.distance(stitch, 2)
+    assert colour[w][d < 0.7][:, 0].max() > 2 * np.median(colour[..., 0])
+
+
+def test_trousers_are_not_sweatpants(body):
+    trousers = builtin.BY_NAME["trousers"].make(body)
+    sweats = builtin.BY_NAME["sweatpants"].make(body)
+    assert sweats.layout is None  # jersey tiles; trousers carry their construction
+    creases = _kinds(trousers, "crease")
+    assert len(creases) == 4  # a pressed crease down each panel
+    for c in creases:  # long and straight down the leg
+        assert np.ptp(c.points[:, 1]) > 3 * np.ptp(c.points[:, 0])
+    assert len(_kinds(trousers, "button")) >= 3  # fly button, back welt pockets
+    assert builtin.BY_NAME["trousers"].fabric == "wool"
+    # Sweatpants gather at the ankle (a cuff); trousers fall straight.
+    ankle = _leg_radius(body, sweats.mesh.vertices, 0.92)
+    assert _leg_radius(body, trousers.mesh.vertices, 0.92) > 1.15 * ankle
+
+
+# ---------------------------------------------------------------------------- skirt, dress
+
+
+def _pose(human, abduct: float = 0.0, stride: float = 0.0) -> np.ndarray:
+    """(J, 4, 4) skinning matrices: thighs apart by ``abduct`` degrees each and swung
+    ``stride`` degrees forward/back (left forward)."""
+    sk = human.skeleton
+    rot = np.zeros((len(sk.names), 4))
+    rot[:, 0] = 1
+    for side, s in ((".L", 1), (".R", -1)):
+        b = sk.names.index("upperleg01" + side)
+        q = quaternion.from_axis_angle(np.array([0, 1.0, 0]), np.radians(-s * abduct))
+        q = quaternion.multiply(quaternion.from_axis_angle(np.array([1.0, 0, 0]),
+                                                           np.radians(s * stride)), q)
+        rot[b] = procedural._local(sk, b, q)
+    world = kinematics.forward(sk, rot[None], np.zeros((1, len(sk.names), 3)))
+    return kinematics.skinning_matrices(sk, world)[0]
+
+
+def _hem_after(name: str, matrices_of):
+    human = Human({"gender": 0.0}).dressed(name)
+    outfit = human.outfit
+    rest = outfit.garments[0].mesh.vertices
+    m = matrices_of(human)
+    body = skinning.linear_blend(human.vertices, human.weights, m)
+    posed = outfit.frame(body, m, exact=True)[0]
+    hem = rest[:, 2] < np.percentile(rest[:, 2], 4)
+    return rest, posed, hem
+
+
+def test_skirt_swings_as_one_and_does_not_split_between_the_legs():
+    rest, posed, hem = _hem_after("skirt", lambda h: _pose(h, stride=28))
+    front = rest[:, 1] < np.median(rest[hem, 1])
+    middle = hem & front & (np.abs(rest[:, 0]) < 0.03)
+    sides = hem & front & (np.abs(np.abs(rest[:, 0]) - 0.09) < 0.03)
+    # Split: the front middle pulled back between the legs (measured 21 cm before the fix).
+    assert posed[middle, 1].mean() - posed[sides, 1].mean() < 0.04
+    # Its hem stays a skirt's, not torn front to back (45 cm deep before the fix).
+    assert np.ptp(posed[hem, 1]) < 0.2
+
+
+def test_skirt_and_dress_do_not_bell_in_a_wide_stance():
+    for name, most in (("skirt", 1.4), ("dress", 1.5)):
+        rest, posed, hem = _hem_after(name, lambda h: _pose(h, abduct=22))
+        assert np.ptp(posed[hem, 0]) < most * np.ptp(rest[hem, 0]), name
+
+
+def test_skirt_has_a_waistband_zip_and_hem(body):
+    piece = builtin.BY_NAME["skirt"].make(body)
+    assert piece.layout.extras["panels"] == ["front", "back"]
+    stitches = _kinds(piece, "stitch")
+    assert len(stitches) >= 3 * 2 + 2  # waistband, top edge and hem per panel, the zip
+    weights = piece.binding.weights
+    assert np.allclose(weights.sum(axis=1), 1.0)
+    assert (weights[:, 2] > 0.3).all()  # every vertex follows the hips too
+
+
+def test_dress_has_no_band_round_the_waist(body):
+    mesh = builtin.BY_NAME["dress"].make(body).mesh
+    m = body.marks
+    v = mesh.vertices
+    waist = (np.abs(v[:, 2] - (m.hip[0, 2] + 0.03)) < 0.02) & (v[:, 1] < m.neck[1])
+    d, _ = body.skin_tree.query(v[waist])
+    # A band would stand 1.5 mm proud of the bodice: no two layers of cloth at the waist
+    # beyond the skirt over the bodice.
+    assert np.percentile(d, 95) - np.percentile(d, 5) < 0.03
+
+
+# ---------------------------------------------------------------------------- cap, hood
+
+
+def test_cap_has_six_gores_a_button_and_a_separate_curved_brim(body):
+    piece = builtin.BY_NAME["cap"].make(body)
+    assert sum(1 for m in piece.layout.marks if m.kind == "seam") == headwear.GORES + 1
+    crown_mesh, rim = headwear.crown(body)
+    brim = headwear.brim(body, crown_mesh, rim)
+    v = brim.vertices
+    # Thickness: every top-sheet point has a bottom-sheet point BRIM_THICK under it.
+    top_sheet = v[: len(v) // 2]
+    gap = np.min(np.linalg.norm(v[None, len(v) // 2 :] - top_sheet[:200, None], axis=2), axis=1)
+    assert np.percentile(gap, 50) < headwear.BRIM_THICK * 1.5
+    assert np.ptp(v[:, 2]) > 0.015  # curved down towards its sides
+    forehead = body.vertices[:13380][body.part[:13380] == "head"][:, 1].min()
+    assert v[:, 1].min() < forehead - 0.05  # stands out in front
+    # The brim is a closed plate: no open edges along its outline.
+    edges, _ = boundary_edges(brim.faces)
+    assert len(edges) <= 4
+    # A button on top: the highest points of the cap form a small dome above the crown.
+    cap_top = piece.mesh.vertices[:, 2].max()
+    assert cap_top > crown_mesh.vertices[:, 2].max() + 0.002
+    # The crown is smooth, not stripes of scalp: neighbours along a meridian change slowly.
+    grid = crown_mesh.vertices[:-1].reshape(headwear.RINGS, headwear.MERIDIANS, 3)
+    bumps = np.linalg.norm(grid[1:-1] - (grid[:-2] + grid[2:]) / 2, axis=2)
+    assert np.percentile(bumps, 95) < 0.004
+
+
+def test_cap_stays_outside_the_head_and_hair():
+    human = Human({"gender": 1.0}).dressed("hair-short", "cap")
+    cap = [g for g in human.outfit.garments if g.name == "cap"][0]
+    from avatar.geometry import collision
+
+    surface = collision.skin_surface(human.model.base.faces[human.model.base.face_groups["body"]])
+    q = collision.query(human.vertices[:13380], surface, cap.mesh.vertices, k=4)
+    assert q.distance.min() > -0.001
+
+
+def test_hoodie_hood_narrows_to_a_point_and_has_drawstrings(body):
+    mesh = builtin.BY_NAME["hoodie"].make(body).mesh
+    hood = builtin._hood(body).mesh.vertices
+    m = body.marks
+    widths = []
+    for z in (m.neck[2] - 0.04, m.neck[2] - 0.12, m.neck[2] - 0.2):
+        band = hood[np.abs(hood[:, 2] - z) < 0.015]
+        widths.append(np.ptp(band[:, 0]))
+    assert widths[0] > widths[1] > widths[2]  # wide at the shoulders, a point below
+    cords = builtin._drawstrings(body).mesh.vertices
+    assert (cords[:, 1] < m.neck[1] - 0.02).all()  # in front of the chest
+    assert cords[:, 2].min() < m.neck[2] - 0.17  # hanging down
+    assert np.ptp(cords[:, 0]) > 0.05  # one either side
+    assert len(mesh.vertices) > len(hood) + len(cords)
