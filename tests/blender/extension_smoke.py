@@ -28,6 +28,7 @@ import json
 import os
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 # What the zip must bring: the library, what it imports beyond numpy, and the assets' wheel.
@@ -63,7 +64,9 @@ def main() -> int:
 
     print("blender", bpy.app.version_string, "python", sys.version.split()[0],
           "numpy", np.__version__)
+    start = time.perf_counter()
     install(bpy, args.zip)
+    print(f"install ok ({time.perf_counter() - start:.1f} s)")
     if args.zip_alone:
         check_installed_from(user)
     if args.layouts:
@@ -75,11 +78,13 @@ def main() -> int:
 
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
+    start = time.perf_counter()  # the first human also compiles the assets' cache
     assert bpy.ops.avatar.create_human() == {"FINISHED"}
+    first = time.perf_counter() - start
     root = bpy.context.view_layer.objects.active
     got = set(live.part_objects(root))
     assert got == {*PART_GROUPS, "hair-short", "eyebrows", "eyelashes"}, (root.name, got)
-    print("create ok")
+    print(f"create ok (first human {first:.1f} s)")
     root.avatar.weight = 0.8
     root.avatar.african = 0.5
     assert bpy.ops.avatar.wear(name="tshirt") == {"FINISHED"}

@@ -97,10 +97,14 @@ def _hull_perimeter(p: np.ndarray) -> float:
     if len(p) < 3:
         return 0.0
 
+    def turn(a: np.ndarray, b: np.ndarray) -> float:
+        # The 2-D cross product written out: numpy 2.5+ (Blender 5.x) rejects 2-vectors.
+        return float(a[0] * b[1] - a[1] * b[0])
+
     def half(points: np.ndarray) -> list[np.ndarray]:
         out: list[np.ndarray] = []
         for q in points:
-            while len(out) >= 2 and np.cross(out[-1] - out[-2], q - out[-2]) <= 0:
+            while len(out) >= 2 and turn(out[-1] - out[-2], q - out[-2]) <= 0:
                 out.pop()
             out.append(q)
         return out
