@@ -1,30 +1,39 @@
 """Live motion capture: solve time, end-to-end latency on loopback, error under noise.
 
-    .venv/bin/python bench/mocap.py [--frames 240] [--clip PATH.bvh] [--baseline REV]
-        [--video CLIP.mp4 | --no-video]
+    .venv/bin/python bench/mocap.py [--frames 240] [--clip PATH.bvh] [--runs 5]
+        [--reference REV] [--no-errors] [--video CLIP.mp4 | --no-video]
 
 1. Solve time per frame (keypoints -> pose, streaming ``PoseSolver``) for COCO-17 and
-   MediaPipe-33 on the default rig (goal < 1 ms), with the anchor: one 3x3 numpy matrix
-   product timed in the same run (the machine is shared; the ratio travels).
-2. End to end on loopback (goal < 16.7 ms, one 60 Hz frame): a VMC bundle sent ->
-   received, assembled, turned into the rig's pose and its joints posed (forward
-   kinematics); and a JSON keypoints datagram sent -> received and solved.
+   MediaPipe-33 on the default rig (goal < 1 ms), CPU time of this process (the machine is
+   shared), each number the median of --runs runs. Two anchors measured in the same runs,
+   interleaved with the solver: forward kinematics of the same rig for the same frames
+   (``world_pose``, one frame per call: a fixed numpy workload), and the reference solver:
+   ``avatar.mocap`` (rotations, filters, feet, plan, solver) as it was at git revision
+   --reference (default: the last commit before the plain-float rewrite), imported under
+   another name.
+2. End to end on loopback (goal < 16.7 ms, one 60 Hz frame), wall time from the send to
+   the posed skin mesh (13,380 vertices, linear blend skinning) in this process:
+   (a) VMC: bundles built and sent with python-osc alone (not Avatar's sender) -> Avatar's
+       VMC receiver -> HumanBodyBones onto the rig -> forward kinematics -> skinning;
+   (b) keypoints: JSON datagrams written with ``json`` alone -> Avatar's keypoint receiver
+       -> ``PoseSolver`` -> forward kinematics -> skinning.
+   Median and 95th percentile per run; the median over runs is reported.
 3. Error against Gaussian keypoint noise (0-30 mm) and random joint dropout (0-30 %):
    mean and 95th percentile of the 12 body joints' error, fixture walk on the default rig,
    unfiltered and with the default One Euro filter (whose lag shows as error on a walk).
 4. MediaPipe Pose frames/s on this CPU (full model, tracking mode) on --video, or on a short
    Workbench render of the fixture walk (needs the mocap extra and bpy).
-
---baseline REV also times ``src/avatar/mocap/solver.py`` as it was at git revision REV (e.g.
-the commit before a speed-up) in the same run, interleaved with the current one.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import functools
+import importlib
+import json
 import os
 import socket
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -32,11 +41,15 @@ import time
 from pathlib import Path
 
 import numpy as np
+from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
+from pythonosc.osc_message_builder import OscMessageBuilder
+from pythonosc.udp_client import UDPClient
 
 import avatar
-from avatar.mocap import filters, keypoint_stream, keypoints, live, solver, unity, vmc
+from avatar.mocap import filters, keypoints, live, solver, unity
 from avatar.motion import load_bvh, retarget
 from avatar.motion.timing import select
+from avatar.rig import kinematics, skinning
 from avatar.rig.kinematics import world_pose
 
 FIXTURE = (
@@ -45,43 +58,202 @@ FIXTURE = (
 BODY = ("left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
         "right_wrist", "left_hip", "right_hip", "left_knee", "right_knee", "left_ankle",
         "right_ankle")  # fmt: skip
+# The solver before the plain-float rewrite (numpy per dependency level, 2.2-2.6 ms/frame
+# on the 2-core container); results pinned by tests/mocap/test_solver_regression.py.
+REFERENCE = "4a19b57"
+MODULES = ("rotations", "filters", "feet", "plan", "solver")
+FRAME_MS = 1000.0 / 60.0
 
 
-def anchor_us() -> float:
-    a = np.eye(3)
-    t = time.process_time()
-    for _ in range(20000):
-        a @ a
-    return (time.process_time() - t) / 20000 * 1e6
+# -- 1. solve time -----------------------------------------------------------------------
 
 
-def solve_time(rig, truth, module=solver, repeats: int = 3) -> float:
-    """Best of ``repeats`` runs over the clip, ms per frame (CPU time of this process: the
-    machine is shared)."""
-    best = []
-    for _ in range(repeats):
-        s = module.PoseSolver(rig, module.SolverSettings())
-        for i in range(10):
-            s(truth[i], None, i / 30)
-        t = time.process_time()
-        for i in range(len(truth)):
-            s(truth[i], None, (i + 10) / 30)
-        best.append((time.process_time() - t) / len(truth) * 1e3)
-    return min(best)
-
-
-def baseline_solver(rev: str):
-    """``avatar.mocap.solver`` as it was at git revision ``rev``, imported under another name."""
+def reference_solver(rev: str):
+    """``avatar.mocap.solver`` with the modules it leans on as they were at git revision
+    ``rev``, imported as a private package (None when git or the revision is missing)."""
     root = Path(__file__).resolve().parents[1]
-    text = subprocess.run(["git", "show", f"{rev}:src/avatar/mocap/solver.py"], cwd=root,
-                          check=True, capture_output=True, text=True).stdout  # fmt: skip
-    path = Path(tempfile.mkdtemp(prefix="avatar-bench-")) / "baseline_solver.py"
-    path.write_text(text)
-    spec = importlib.util.spec_from_file_location("baseline_solver", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["baseline_solver"] = module
-    spec.loader.exec_module(module)
-    return module
+    package = "avatar_mocap_" + "".join(c if c.isalnum() else "_" for c in rev)
+    folder = Path(tempfile.mkdtemp(prefix="avatar-bench-")) / package
+    folder.mkdir()
+    (folder / "__init__.py").write_text("")
+    for name in MODULES:
+        try:
+            text = subprocess.run(["git", "show", f"{rev}:src/avatar/mocap/{name}.py"],
+                                  cwd=root, check=True, capture_output=True,
+                                  text=True).stdout  # fmt: skip
+        except (OSError, subprocess.CalledProcessError):
+            return None
+        for other in MODULES:
+            text = text.replace(
+                f"from avatar.mocap import {other}", f"from {package} import {other}"
+            )
+            text = text.replace(f"avatar.mocap.{other}", f"{package}.{other}")
+        (folder / f"{name}.py").write_text(text)
+    sys.path.insert(0, str(folder.parent))
+    return importlib.import_module(f"{package}.solver")
+
+
+def solve_ms(module, rig, truth) -> float:
+    """CPU ms per frame of one streaming solve of ``truth`` (10 frames of warm-up first)."""
+    s = module.PoseSolver(rig, module.SolverSettings())
+    for i in range(10):
+        s(truth[i], None, i / 30)
+    t = time.process_time()
+    for i in range(len(truth)):
+        s(truth[i], None, (i + 10) / 30)
+    return (time.process_time() - t) / len(truth) * 1e3
+
+
+def fk_ms(skeleton, clip) -> float:
+    """CPU ms per frame of forward kinematics of the rig, one frame per call (the anchor)."""
+    rotations, translations = clip.rotations, clip.translations
+    t = time.process_time()
+    for i in range(clip.frames):
+        world_pose(skeleton, rotations[i], translations[i])
+    return (time.process_time() - t) / clip.frames * 1e3
+
+
+def solve_times(human, clip, runs: int, reference) -> None:
+    """Print solve ms/frame per keypoint set: medians over runs, ratios to the anchors."""
+    modules = {"solver": solver} | ({"reference": reference} if reference else {})
+    for name in ("coco17", "mediapipe33"):
+        rig = keypoints.bind(name, human.skeleton)
+        truth = rig.positions(clip)
+        got: dict[str, list[float]] = {k: [] for k in [*modules, "fk"]}
+        for _ in range(runs):  # interleaved, so load changes hit every column alike
+            for label, module in modules.items():
+                got[label].append(solve_ms(module, rig, truth))
+            got["fk"].append(fk_ms(human.skeleton, clip))
+        ms, fk = statistics.median(got["solver"]), statistics.median(got["fk"])
+        per_run = [a / b for a, b in zip(got["solver"], got["fk"], strict=True)]
+        line = (f"solve {name:12s} {ms:6.3f} ms/frame (runs {min(got['solver']):.3f}-"
+                f"{max(got['solver']):.3f}; goal 1 ms) = {statistics.median(per_run):4.2f} x FK "
+                f"of the rig ({fk:.3f} ms)")  # fmt: skip
+        if reference:
+            old = statistics.median(got["reference"])
+            speed = [a / b for a, b in zip(got["reference"], got["solver"], strict=True)]
+            line += f"; reference {old:6.3f} ms: {statistics.median(speed):4.2f}x faster"
+        print(line)
+
+
+# -- 2. end to end ------------------------------------------------------------------------
+
+
+class PosedMesh:
+    """Pose -> the body's skin vertices (V, 3): forward kinematics (Blender's pose-bone
+    evaluation, as ``kinematics.forward``) and linear blend skinning, with what depends only
+    on the rig (local rest matrices, inverse rest matrices, hierarchy levels) computed once,
+    as a live consumer would."""
+
+    def __init__(self, human):
+        sk = human.skeleton
+        self.skeleton = sk
+        self.local_rest = sk.local_rest()
+        self.inverse_rest = np.linalg.inv(sk.rest)
+        self.levels = [(g, sk.parents[g]) for g in kinematics.levels(sk.parents)]
+        self.vertices = human.body.skin_vertices
+        self.weights = human.body.skin_weights
+
+    def __call__(self, rotations: np.ndarray, translations: np.ndarray) -> np.ndarray:
+        local = self.local_rest @ kinematics.pose_matrices(rotations, translations)
+        world = np.empty_like(local)
+        for group, parents in self.levels:
+            world[group] = local[group] if parents[0] < 0 else world[parents] @ local[group]
+        return skinning.linear_blend(self.vertices, self.weights, world @ self.inverse_rest)
+
+    def check(self, rotations: np.ndarray, translations: np.ndarray) -> None:
+        """Same vertices as the library's own path (``Human.posed``'s steps)."""
+        world = kinematics.forward(self.skeleton, rotations, translations)
+        matrices = kinematics.skinning_matrices(self.skeleton, world)
+        expected = skinning.linear_blend(self.vertices, self.weights, matrices)
+        assert np.allclose(self(rotations, translations), expected, atol=1e-5)
+
+
+def vmc_bundles(skeleton, clip, count: int) -> list:
+    """``count`` VMC frames of the clip as python-osc bundles, built from the spec's
+    messages directly (Root/Pos, Bone/Pos per HumanBodyBones bone, OK, T); the clip's poses
+    in Unity's axes from ``unity.UnityRig`` (before any timing)."""
+    rig = unity.UnityRig(skeleton)
+    out = []
+    for i in range(count):
+        pose = rig.to_unity(clip.rotations[i % clip.frames], clip.translations[i % clip.frames])
+        bundle = OscBundleBuilder(IMMEDIATELY)
+        messages = [("/VMC/Ext/Root/Pos", ["root", *pose.root[0], *pose.root[1]])]
+        messages += [("/VMC/Ext/Bone/Pos", [bone, *p, *q]) for bone, (p, q) in pose.bones.items()]
+        messages += [("/VMC/Ext/OK", [1]), ("/VMC/Ext/T", [i / 60])]
+        for address, args in messages:
+            m = OscMessageBuilder(address)
+            for a in args:
+                if isinstance(a, str | int):
+                    m.add_arg(a, "s" if isinstance(a, str) else "i")
+                else:
+                    m.add_arg(float(a), "f")
+            bundle.add_content(m.build())
+        out.append(bundle.build())
+    return out
+
+
+def keypoint_datagrams(truth: np.ndarray, count: int) -> list[bytes]:
+    """``count`` frames of keypoints as the stream's documented JSON, written by hand."""
+    return [json.dumps({"seq": i, "t": i / 60, "axes": "avatar",
+                        "points": [[round(v, 6) for v in p] for p in truth[i % len(truth)].tolist()]
+                        }).encode()
+            for i in range(count)]  # fmt: skip
+
+
+def round_trips(source, send, frames: list, mesh: PosedMesh) -> tuple[list, list]:
+    """Wall ms from each send to its posed mesh, and of the posing alone."""
+    total, posing = [], []
+    for data in frames:
+        t0 = time.perf_counter()
+        send(data)
+        pose = None
+        while pose is None:
+            time.sleep(0.0002)  # yield the interpreter to the receiving thread
+            pose = source.poll()
+        t1 = time.perf_counter()
+        vertices = mesh(pose.rotations, pose.translations)
+        t2 = time.perf_counter()
+        assert np.isfinite(vertices).all()
+        total.append((t2 - t0) * 1e3)
+        posing.append((t2 - t1) * 1e3)
+        time.sleep(0.002)
+    return total, posing
+
+
+def _send_to(sock: socket.socket, address: tuple[str, int], data: bytes) -> None:
+    sock.sendto(data, address)
+
+
+def latencies(human, clip, runs: int, count: int = 150) -> None:
+    mesh = PosedMesh(human)
+    mesh.check(clip.rotations[0], clip.translations[0])
+    rig = keypoints.bind("coco17", human.skeleton)
+    paths = {
+        "VMC (python-osc) -> posed mesh": (lambda: live.open_vmc(human.skeleton, "127.0.0.1", 0),
+                                           vmc_bundles(human.skeleton, clip, count)),
+        "keypoints JSON -> solved -> posed mesh": (
+            lambda: live.open_keypoints(rig, "127.0.0.1", 0),
+            keypoint_datagrams(rig.positions(clip), count)),
+    }  # fmt: skip
+    for label, (open_source, frames) in paths.items():
+        medians, p95s, worst, posing = [], [], [], []
+        for _ in range(runs):
+            with open_source() as source, socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
+                if "VMC" in label:
+                    send = UDPClient(*source.address).send  # python-osc's own client
+                else:
+                    send = functools.partial(_send_to, tx, source.address)
+                total, pose_ms = round_trips(source, send, frames, mesh)
+            medians.append(float(np.median(total)))
+            p95s.append(float(np.percentile(total, 95)))
+            worst.append(max(total))
+            posing.append(float(np.median(pose_ms)))
+        med, p95 = statistics.median(medians), statistics.median(p95s)
+        skin = statistics.median(posing)
+        print(f"latency {label:38s} median {med:5.2f} ms, 95% {p95:5.2f} ms, "
+              f"worst {max(worst):5.2f} ms ({med / FRAME_MS:.2f} / {p95 / FRAME_MS:.2f} of a "
+              f"60 Hz frame; posing and skinning {skin:.2f} ms of it)")  # fmt: skip
 
 
 def mediapipe_rate(video_path: str | None) -> str:
@@ -114,42 +286,6 @@ def mediapipe_rate(video_path: str | None) -> str:
             f"person found in {int(pose.found.sum())}/{len(pose.points)} frames")  # fmt: skip
 
 
-def vmc_latency(skeleton, clip, count=200) -> np.ndarray:
-    rig = unity.UnityRig(skeleton)
-    out = []
-    with live.open_vmc(skeleton, "127.0.0.1", 0) as source, vmc.VmcSender(*source.address) as tx:
-        for i in range(count):
-            pose = rig.to_unity(clip.rotations[i % clip.frames], clip.translations[i % clip.frames])
-            t0 = time.perf_counter()
-            tx.send(pose, i / 60)
-            got = None
-            while got is None:
-                time.sleep(0.0002)  # yield the interpreter to the receiving thread
-                got = source.poll()
-            world_pose(skeleton, got.rotations, got.translations)  # the posed joints
-            out.append(time.perf_counter() - t0)
-            time.sleep(0.002)
-    return np.array(out) * 1e3
-
-
-def keypoint_latency(rig, truth, count=200) -> np.ndarray:
-    out = []
-    with live.open_keypoints(rig, "127.0.0.1", 0) as source:
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        for i in range(count):
-            data = keypoint_stream.encode(i, truth[i % len(truth)], None, i / 60, axes="avatar")
-            t0 = time.perf_counter()
-            sock.sendto(data, source.address)
-            got = None
-            while got is None:
-                time.sleep(0.0002)  # yield the interpreter to the receiving thread
-                got = source.poll()
-            out.append(time.perf_counter() - t0)
-            time.sleep(0.002)
-        sock.close()
-    return np.array(out) * 1e3
-
-
 def error_curve(rig, clip, truth, smoothing) -> list[tuple[float, float, float, float]]:
     body = [rig.keypoints.index(n) for n in BODY]
     rows = []
@@ -171,40 +307,33 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=240)
     parser.add_argument("--clip", default=str(FIXTURE))
-    parser.add_argument("--baseline", metavar="REV", help="also time the solver at git REV")
+    parser.add_argument("--runs", type=int, default=5, help="runs per measurement (medians)")
+    parser.add_argument("--reference", metavar="REV", default=REFERENCE,
+                        help="time the solver at git REV too ('' : not)")  # fmt: skip
+    parser.add_argument("--no-errors", action="store_true", help="skip the error curve")
     parser.add_argument("--video", help="MediaPipe frames/s on this video")
     parser.add_argument("--no-video", action="store_true", help="skip MediaPipe")
     args = parser.parse_args()
     human = avatar.Human()
     source, clip = load_bvh(args.clip)
     clip, _ = retarget(source, select(clip, slice(0, args.frames)), human.skeleton, measure=False)
-    print(f"clip: {Path(args.clip).name}, {clip.frames} frames at {clip.fps:g} fps, default rig")
-    anchor = anchor_us()
-    print(f"anchor: one 3x3 matrix product {anchor:.2f} us")
-    old = baseline_solver(args.baseline) if args.baseline else None
-    for name in ("coco17", "mediapipe33"):
-        rig = keypoints.bind(name, human.skeleton)
+    print(f"clip: {Path(args.clip).name}, {clip.frames} frames at {clip.fps:g} fps, default "
+          f"rig; {os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}; medians of {args.runs} "
+          "runs")  # fmt: skip
+    reference = reference_solver(args.reference) if args.reference else None
+    if args.reference and reference is None:
+        print(f"reference solver at {args.reference}: not available (no git or no such revision)")
+    solve_times(human, clip, args.runs, reference)
+    latencies(human, clip, args.runs)
+    if not args.no_errors:
+        rig = keypoints.bind("coco17", human.skeleton)
         truth = rig.positions(clip)
-        if old is not None:
-            ms = solve_time(rig, truth, old)
-            print(f"solve {name:12s} {ms:6.3f} ms/frame  (= {ms * 1000 / anchor:5.0f} anchors) "
-                  f"at {args.baseline}")  # fmt: skip
-        ms = solve_time(rig, truth)
-        print(f"solve {name:12s} {ms:6.3f} ms/frame  (= {ms * 1000 / anchor:5.0f} anchors; "
-              f"goal 1 ms)")  # fmt: skip
-    rig = keypoints.bind("coco17", human.skeleton)
-    truth = rig.positions(clip)
-    for label, lat in (("VMC -> posed joints", vmc_latency(human.skeleton, clip)),
-                       ("keypoints UDP -> solved", keypoint_latency(rig, truth))):  # fmt: skip
-        p95 = np.percentile(lat, 95)
-        print(f"latency {label:24s} median {np.median(lat):6.2f} ms, 95% {p95:6.2f} ms,"
-              f" max {lat.max():6.2f} ms  (goal 16.7 ms)")  # fmt: skip
-    print("body joint error, mm (12 joints): mean / 95th percentile")
-    print("noise mm  dropout %   unfiltered     One Euro (defaults)")
-    off = error_curve(rig, clip, truth, filters.OneEuro.off())
-    on = error_curve(rig, clip, truth, filters.OneEuro())
-    for (noise, drop, m0, p0), (_, _, m1, p1) in zip(off, on, strict=True):
-        print(f"{noise:8.0f}  {drop:9.0f}  {m0:6.1f} / {p0:5.1f}   {m1:6.1f} / {p1:5.1f}")
+        print("body joint error, mm (12 joints): mean / 95th percentile")
+        print("noise mm  dropout %   unfiltered     One Euro (defaults)")
+        off = error_curve(rig, clip, truth, filters.OneEuro.off())
+        on = error_curve(rig, clip, truth, filters.OneEuro())
+        for (noise, drop, m0, p0), (_, _, m1, p1) in zip(off, on, strict=True):
+            print(f"{noise:8.0f}  {drop:9.0f}  {m0:6.1f} / {p0:5.1f}   {m1:6.1f} / {p1:5.1f}")
     if not args.no_video:
         print(mediapipe_rate(args.video))
 
