@@ -19,7 +19,7 @@ from avatar.io import gltf, images
 
 ROOT = Path(__file__).resolve().parents[2]
 VALIDATOR = ROOT / ".cache/node/node_modules/gltf-validator"
-WEAR = ("tshirt", "jeans", "hair-short", "beard-short", "eyebrows")
+WEAR = ("tshirt", "jeans", "hair-short", "beard-short", "eyebrows", "stubble")
 
 
 def test_preset_options():
@@ -69,6 +69,13 @@ def test_game_glb_fits_the_budget_and_reads_back(game_glb):
     assert {"beard-short", "hair-short"} <= set(parts)
     hair = parts["hair-short"].material
     assert hair.alpha_mode == "MASK" and hair.base_color_texture is not None
+    # Hair in the file: cut-out (MASK) or blended (BLEND) with a colour texture, both sides.
+    materials = {m.name: m for m in raw.materials}
+    for name, mode in (("hair-short", "MASK"), ("beard-short", "MASK"), ("eyebrows", "BLEND"),
+                       ("stubble", "BLEND")):  # fmt: skip
+        m = materials[name]
+        assert m.alphaMode == mode and m.pbrMetallicRoughness.baseColorTexture is not None
+    assert materials["hair-short"].doubleSided
 
 
 def test_full_preset_keeps_eight_influences_and_no_lods(tmp_path, model):
