@@ -25,7 +25,7 @@ between some frames and their exact resolves. Those errors matter only where the
 the body, and the exact resolve is only one way out of it; so the bake then plays every frame
 back as a viewer will (``REFINE_PASSES`` checks): vertices more than ``ERROR_BOUND`` inside
 the skin are pushed out (``MARGIN`` beyond it), the frame's weights are solved again with
-them weighted ``HEAVY``, and (first half of the checks) the shapes are refitted to the mended
+them weighted ``HEAVY``, and (the first ``REFITS`` checks) the shapes are refitted to the mended
 frames, which are low-rank by construction. What is left is measured in docs/benchmarks.md.
 
     parts, weights = bake(human.body, human.outfit, animation, human.parts())
@@ -60,7 +60,8 @@ ERROR_BOUND = 5e-4  # m: worst distance of a played-back garment vertex from its
 MAX_BASIS = 16  # correction shapes a garment gets when they meet ERROR_BOUND (the usual case)
 LIMIT = 64  # most shapes a garment gets when ERROR_BOUND needs more than MAX_BASIS
 BASIS_PREFIX = "correction_"
-REFINE_PASSES = 4  # play-back checks; each pushes out what went inside (the first half refit)
+REFINE_PASSES = 12  # play-back checks; each pushes out what went inside (stops when none did)
+REFITS = 6  # the first checks that also refit the shapes to the mended frames
 MARGIN = 1.5e-3  # m: how far outside the skin a check puts a vertex it pushes out
 HEAVY = 100.0  # weight of pushed-out vertices in a frame's least-squares weights
 
@@ -111,7 +112,7 @@ def bake(
         if not _played_back_fixes(body, animation, garments, skins, corrections, bases, collide,
                                   heavy, bound):  # fmt: skip
             break
-        if step < REFINE_PASSES // 2:  # refit the shapes to the mended frames, then the weights
+        if step < REFITS:  # refit the shapes to the mended frames, then the weights
             bases = [fit(c, bound) for c in corrections]
             for i, basis in enumerate(bases):
                 if basis is None:
