@@ -88,3 +88,13 @@ def test_stubble_texture_tiles_and_is_see_through():
     seam = np.abs(alpha[:, 0].astype(int) - alpha[:, -1]).mean()
     inner = np.abs(alpha[:, 100].astype(int) - alpha[:, 101]).mean()
     assert seam < 2 * inner + 5
+
+
+def test_beard_cards_are_sparser_than_scalp_hair():
+    """Beard cards show skin between their hairs (a scalp card's strands would read as a
+    solid block on the face)."""
+    beard = load_garment("beard-short", texture_size=256).material.base_color_texture
+    scalp = load_garment("hair-short", texture_size=256).material.base_color_texture
+    half = slice(128, 256)  # the strand cards' rows
+    beard_cover = (beard[half, :, 3] > 127).mean()
+    assert beard_cover < 0.5 * (scalp[half, :, 3] > 127).mean() and beard_cover > 0.05

@@ -17,11 +17,16 @@ from avatar.material import Material
 
 def beard_material(spec, size: int = 1024) -> Material:
     """A beard's or moustache's cut-out strand material in the spec's hair colour (the
-    scalp hair's, ``textures.hair_material``), its strands thinned (alpha x 0.8, so more
-    of each card is cut away and skin shows between the short hairs)."""
+    scalp hair's, ``textures.hair_material``) with its card strands thinned: beard hair is
+    sparse, so only about two hair-wide columns in five are kept and skin shows between
+    them (a card of scalp strands would read as a solid block on the face)."""
     m = textures.hair_material(spec, size)
     colour = np.array(m.base_color_texture, copy=True)
-    colour[..., 3] = (colour[..., 3].astype(np.float32) * 0.8).astype(np.uint8)
+    rng = np.random.default_rng([size, 17])
+    hair = max(size // 340, 1)  # texels per hair across (a card's ~0.1 mm at 1024 px)
+    kept = np.repeat(rng.uniform(size=size // hair + 1) < 0.4, hair)[:size]
+    cards = slice(size - size // 2, size)  # rows of the strand-card half (v in [0, 0.5])
+    colour[cards, :, 3] = colour[cards, :, 3] * kept[None, :]
     return replace(m, base_color_texture=colour)
 
 
