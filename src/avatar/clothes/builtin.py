@@ -22,6 +22,7 @@ from avatar.clothes.authoring import (
     covered_skin,
     cut,
     join,
+    orient_outward,
     with_box_uvs,
 )
 from avatar.clothes.fitting import Garment
@@ -213,27 +214,46 @@ def _dress(body: AuthoringBody) -> Piece:
     return join([bound(body, bodice, faces), skirt_piece])
 
 
-def _hood(body: AuthoringBody) -> Piece:
-    """A hood lying down on the back: from the neckline, a pouch that narrows to a rounded
-    point between the shoulder blades, flat in its middle and rolled up at its rim (the face
-    opening folded over), the rim banded so the cloth shows its thickness."""
-    faces = body.group_faces("helper-tights")
+def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
+    """A hood lying down on the back: a pouch hanging from round the neck, widest over the
+    shoulder blades and narrowing to a rounded point, flat in its middle and rolled up at
+    its rim (the face opening folded over), the rim banded so the cloth shows its
+    thickness. Modelled as a grid over the back (the helper mesh is too coarse to cut a
+    point from), each point the back's surface plus the hood's puff, then bound to it."""
     m = body.marks
-    c = body.vertices[faces].mean(axis=1)
     low, high = m.neck[2] - 0.24, m.neck[2] + 0.035
-    depth = np.clip((high - c[:, 2]) / (high - low), 0, 1)  # 0 at the neck, 1 at the tip
-    half = 0.15 * np.sqrt(np.clip(1 - depth**2.2, 0, 1)) + 0.01  # a rounded point below
-    keep = (c[:, 1] > m.neck[1] - 0.01) & (c[:, 2] > low) & (c[:, 2] < high)
-    keep &= np.abs(c[:, 0]) < half
 
-    def puff(p, arm, leg):
-        d = np.clip((high - p[:, 2]) / (high - low), 0, 1)
-        edge = np.abs(p[:, 0]) / (0.15 * np.sqrt(np.clip(1 - d**2.2, 0, 1)) + 0.01)
-        rim = np.exp(-(((1 - np.clip(edge, 0, 1)) / 0.22) ** 2))  # the rolled opening
-        pouch = np.sin(np.pi * np.clip(d, 0, 1)) ** 0.8  # the hood's bag lying on the back
-        return 0.01 + 0.018 * pouch + 0.02 * rim * np.clip(d * 3, 0, 1)
+    def half_width(d):
+        """m either side of the spine at depth d (0 at the neck, 1 at the tip)."""
+        wide = 0.075 + 0.08 * np.sin(np.pi / 2 * np.clip(d / 0.5, 0, 1))
+        return wide * np.sqrt(np.clip(1 - (np.clip(d - 0.5, 0, None) / 0.5) ** 2, 0, 1)) + 0.012
 
-    return bound(body, banded(cut(body, faces, keep, puff, relax=RELAX), 0.022, 0.003), faces)
+    d = np.linspace(0, 1, down)[:, None]
+    u = np.linspace(-1, 1, across)[None, :]
+    x = (u * half_width(d)).ravel()
+    z = np.broadcast_to(high - d * (high - low), (down, across)).ravel()
+    skin = body.vertices[: len(body.part)]
+    skin = skin[(skin[:, 1] > m.neck[1] - 0.03) & (skin[:, 2] > low - 0.05)]
+    # The back's surface seen from behind: the farthest back of the nearest skin points.
+    from scipy.spatial import cKDTree
+
+    _, near = cKDTree(skin[:, [0, 2]]).query(np.stack([x, z], -1), k=8)
+    grid = skin[near, 1].max(axis=1).reshape(down, across)
+    for _ in range(3):  # the cloth bridges the spine's and blades' small bumps
+        grid[:, 1:-1] = 0.5 * grid[:, 1:-1] + 0.25 * (grid[:, :-2] + grid[:, 2:])
+        grid[1:-1] = 0.5 * grid[1:-1] + 0.25 * (grid[:-2] + grid[2:])
+    edge = np.abs(np.broadcast_to(u, (down, across)))
+    rim = np.exp(-(((1 - edge) / 0.22) ** 2)) * np.clip(d * 4, 0, 1)  # the rolled opening
+    pouch = np.sin(np.pi * np.clip(d, 0, 1)) ** 0.8  # the hood's bag lying on the back
+    puff = 0.021 + 0.014 * pouch + 0.02 * rim  # over the hoodie (1.3 cm ease, 4 mm thick)
+    points = np.stack([x, (grid + puff).ravel(), z], -1)
+    points = shoes._at_least(body, points, 0.019)  # clear of the skin and the hoodie
+    index = np.arange(down * across).reshape(down, across)
+    faces = np.array([[index[r, c], index[r + 1, c], index[r + 1, c + 1], index[r, c + 1]]
+                      for r in range(down - 1) for c in range(across - 1)], np.int32)  # fmt: skip
+    mesh = orient_outward(body, points.astype(np.float32), faces)
+    mesh = banded(with_box_uvs(mesh), 0.022, 0.003)
+    return bound(body, mesh, body.group_faces("helper-tights"))
 
 
 def _drawstrings(body: AuthoringBody, length: float = 0.2, radius: float = 0.0028) -> Piece:
