@@ -25,7 +25,7 @@ from avatar.clothes.authoring import (
     orient_outward,
     with_box_uvs,
 )
-from avatar.clothes.fitting import Garment
+from avatar.clothes.fitting import CLEARANCE, Garment
 from avatar.clothes.regions import face_features
 from avatar.looks import fabrics, facial_hair, tailored, textures
 from avatar.material import Material
@@ -49,6 +49,9 @@ class Spec:
     collide: bool = True
     # (spec, texture size) -> Material, for garments of several materials in one atlas.
     look: Callable[[Spec, int], Material] | None = None
+    # m a garment keeps off the skin (None: fitting's CLEARANCE). Loose cloth on a coarse
+    # mesh (a skirt) needs more: a thigh curves more than 2 mm between two of its vertices.
+    clearance: float | None = None
 
 
 def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0) -> Piece:
@@ -351,8 +354,8 @@ SPECS = [
     Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow"), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
     Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
-    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",)),  # noqa: E501
-    Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",)),
+    Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",), clearance=0.006),  # noqa: E501
+    Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",), clearance=0.005),
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "cream", "dark brown")),  # noqa: E501
@@ -401,6 +404,7 @@ def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
         z_depth=spec.z_depth,
         delete_verts=delete,
         thickness=spec.thickness,
+        clearance=CLEARANCE if spec.clearance is None else spec.clearance,
         collide=spec.collide,
         category=spec.category,
         tags=spec.tags,
