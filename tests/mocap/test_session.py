@@ -160,7 +160,7 @@ def _bvh_server(text_lines, delay=0.002):
 def test_a_bvh_stream_session_drives_any_rig_as_the_clip_moves(fixtures, rig_skeleton):
     """A CMU clip streamed as BVH text over TCP onto the game_engine rig: every frame
     arrives, and arms and spine point where the library's offline retarget (a different
-    algorithm) points them, within 1 degree (legs and spine: the xfail below)."""
+    algorithm) points them, within 1 degree (legs and trunk: the test below)."""
     from avatar.motion import load_bvh, retarget
     from avatar.motion.timing import select
 
@@ -190,9 +190,6 @@ def test_a_bvh_stream_session_drives_any_rig_as_the_clip_moves(fixtures, rig_ske
     assert arms.max() < 1.0, arms.max()
 
 
-@pytest.mark.xfail(strict=True, reason="unity.UnityRig takes a skeleton's built-in t-pose for "
-                   "Unity's T-pose; CMU's legs stay 20 degrees apart in it (Avatar's 5.7), "
-                   "so streamed CMU legs come out 14 degrees off (the spine 7)")  # fmt: skip
 def test_bvh_stream_legs_and_spine_follow_the_clip(fixtures, rig_skeleton):
     from avatar.mocap import unity
     from avatar.motion import load_bvh, retarget
@@ -209,9 +206,14 @@ def test_bvh_stream_legs_and_spine_follow_the_clip(fixtures, rig_skeleton):
     _, ha = world_pose(skeleton, np.stack([g[0] for g in got]), np.stack([g[1] for g in got]))
     offline, _ = retarget(source, clip, skeleton, measure=False)
     _, hb = world_pose(skeleton, offline.rotations, offline.translations)
-    legs = _direction_errors(skeleton, ha, hb, ("thigh_l", "calf_l"), ("calf_r", "foot_r"),
-                             ("spine_01", "neck_01"))  # fmt: skip
-    assert legs.max() < 2.0, legs.max()
+    # Unity's T-pose has legs straight down and the trunk upright; a rig's own rest splay
+    # taken for it turned CMU's legs 14 degrees, the trunk 7 (UnityRig's humanoid T-pose).
+    legs = _direction_errors(skeleton, ha, hb, ("thigh_l", "calf_l"), ("calf_r", "foot_r"))
+    assert legs.max() < 1.0, legs.max()
+    # The trunk's bend is spread over 3 spine bones here and 2 in CMU's, by two different
+    # algorithms (the offline retarget and the shares of in-between bones): within 3 degrees.
+    trunk = _direction_errors(skeleton, ha, hb, ("spine_01", "neck_01"))
+    assert trunk.max() < 3.0, trunk.max()
 
 
 def _direction_errors(skeleton, ha, hb, *segments):

@@ -92,7 +92,10 @@ class UnityRig:
         self.names = [b[0] for b in human_bones()]
         self.unity_parent = [self.names.index(p) if p else -1 for _, p, _ in human_bones()]
         self.bone_of = self._map(skeleton, bmap)  # Unity index -> rig bone (-1: none)
-        tpose = poselib.built_in(skeleton, "t-pose")
+        # Unity's humanoid T-pose has the legs straight down; poselib's t-pose keeps the
+        # rest's leg splay (CMU's legs stand 20 degrees apart, Avatar's 5.7), which would
+        # turn every streamed leg by the difference.
+        tpose = poselib.arms_out(skeleton, 0.0, bmap, legs_down=True)
         t_rot, t_heads = world_pose(skeleton, tpose.rotations[0], tpose.translations[0])
         self.t_rot, self.t_heads = t_rot, t_heads
         self.rest_rot, self.local_rest = rest_quaternions(skeleton)

@@ -176,10 +176,13 @@ def built_in(skeleton: Skeleton, name: str) -> Animation:
     return arms_out(skeleton, ARM_DROP[name])
 
 
-def arms_out(skeleton: Skeleton, drop_degrees: float, bmap: bonemap.BoneMap | None = None):
+def arms_out(skeleton: Skeleton, drop_degrees: float, bmap: bonemap.BoneMap | None = None,
+             legs_down: bool = False):  # fmt: skip
     """(1, J) pose: both arms straight (upper arm, forearm and hand in one line), held out
-    sideways ``drop_degrees`` below horizontal in the body's frontal plane; legs straight.
-    Sideways is the rest pose's hip-to-hip line; other bones keep their rest relation."""
+    sideways ``drop_degrees`` below horizontal in the body's frontal plane; legs straight
+    (hip to ankle in the rest's frontal plane; ``legs_down``: vertical and parallel, the
+    spine and chest upright, as Unity's humanoid T-pose has them). Sideways is the rest
+    pose's hip-to-hip line; other bones keep their rest relation."""
     bmap = bmap or bonemap.detect(skeleton)
     heads = skeleton.heads
     roles = bmap.bones
@@ -197,8 +200,10 @@ def arms_out(skeleton: Skeleton, drop_degrees: float, bmap: bonemap.BoneMap | No
         ends = [roles.get(f"{r}.{side}") for r in ("thigh", "foot")]
         if None not in ends:
             leg = heads[ends[1]] - heads[ends[0]]
-            leg = geometry.unit(leg - (leg @ forward) * forward)
+            leg = -_UP if legs_down else geometry.unit(leg - (leg @ forward) * forward)
             want.update({f"thigh.{side}": leg, f"shin.{side}": leg})
+    if legs_down:
+        want.update({"spine": _UP, "chest": _UP})
     return aim(skeleton, bmap, want)
 
 
