@@ -58,13 +58,22 @@ def walker(tmp_path_factory):
         "influences": max(_influences(o) for o in built.parts),
         "snapshot": _snapshot(root),
     }
+    expect["data_before"] = _data_counts()
     out = tmp_path_factory.mktemp("exports")
     files = {(p, f): export.export_character(root, out / f"walker_{p.lower()}", p, f)
              for p in PRESETS for f in FORMATS}  # fmt: skip
     files["baked"] = export.export_character(root, out / "baked.fbx", "UNITY", shape_keys="BAKE")
     expect["after"] = _snapshot(root)
+    expect["data"] = _data_counts()
     expect["objects"] = sorted(o.name for o in bpy.data.objects)
     return expect, files
+
+
+def _data_counts() -> list[int]:
+    import bpy
+
+    d = bpy.data
+    return [len(p) for p in (d.meshes, d.armatures, d.actions, d.shape_keys, d.collections)]
 
 
 def _snapshot(root):
@@ -180,6 +189,7 @@ def _fbx_unit_scale(path) -> float:
 def test_the_users_character_is_unchanged(walker):
     expect, _ = walker
     assert expect["after"] == expect["snapshot"]
+    assert expect["data"] == expect["data_before"]  # every copy and its data went
     assert expect["objects"] == sorted([expect["snapshot"][0], *expect["counts"]])
 
 

@@ -229,7 +229,11 @@ def bake_shape_keys(obj: bpy.types.Object) -> None:
             mixed += block.value * (_key_co(block, count) - relative)
     if keys.animation_data is not None:
         keys.animation_data_clear()
+    name = keys.name
     obj.shape_key_clear()
+    left = bpy.data.shape_keys.get(name)  # kept alive (its cleared animation's users)
+    if left is not None and obj.data.shape_keys is None:
+        bpy.data.batch_remove([left])  # else it outlives the mesh and breaks a .blend save
     obj.data.vertices.foreach_set("co", mixed.ravel())
     obj.data.update()
 
