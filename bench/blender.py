@@ -7,9 +7,12 @@ Installs the extension zip (built here, ``--no-wheel``) into a private user fold
 drives it as a script or slider does:
 
 - create a bare human (no rig, no clothes) and a dressed, rigged one with
-  ``avatar.blender.character.create`` (what the Create button calls; real-time garment fit);
-- one slider change (``obj.avatar.weight = v``) on each: mesh, rest bones and garments
-  written in place, timed until the property assignment returns;
+  ``avatar.blender.character.create`` (what the Create button calls; real-time garment fit),
+  timed until the depsgraph is evaluated (``view_layer.update()``: what the viewport needs);
+- slider changes (``obj.avatar.weight = v``) on each: mesh, rest bones and garments written
+  in place. Rows: a *step* of a drag (0.01, on one side of the macro's midpoint 0.5) timed
+  until the assignment returns, the same step plus the depsgraph evaluation, and a *jump*
+  across the midpoint (0.3 <-> 0.7) plus the evaluation;
 - the settle that follows a change (exact garments, skin texture, measurements).
 
 Anchor, measured in the same run: the pre-live extension's path for a change, a whole
@@ -18,21 +21,25 @@ rebuild of the character (``export.character`` + ``scene.build_character``, what
 
 ``--mpfb PATH`` (an MPFB2 checkout, its ``src/`` or its ``src/mpfb`` package; see
 ``bench/mpfb_checkout.py`` for a partial clone) registers MPFB2 as a user extension in the
-same process (its ``register()``) and times the same four steps through its own operators
-(``bench/mpfb_driver.py`` says which), alternating the two add-ons repeat by repeat (the
-order swapped every repeat) so that the load of a shared machine falls on both alike. The
-dressed, rigged human is then the *same* MakeHuman assets on both sides: short02 hair,
-eyebrow001, eyelashes01, male_casualsuit06 (T-shirt + jeans) and shoes01, from ``--assets``
-(default ``../shared/fixtures/makehuman``, CC0), on MakeHuman's 163-bone default rig; MPFB2
-finds them through its "second root" asset folder preference. Its dressed slider change is
-the macro slider plus ``HumanService.refit`` (what "Auto refit assets" runs), both timed.
-Without ``--mpfb`` the MPFB2 column is the issue's MPFB2 2.0.17 figures (same kind of
-machine): 0.29 s create, 1.71 s dressed create, 42 ms bare change, 0.28 s dressed change.
+same process (its ``register()``) and times the same rows through its own operators and
+panel properties (``bench/mpfb_driver.py`` says which), alternating the two add-ons repeat
+by repeat (the order swapped every repeat) so that the load of a shared machine falls on
+both alike; wall clock and process CPU time are both reported. The dressed, rigged human is
+then the *same* MakeHuman assets on both sides: short02 hair, eyebrow001, eyelashes01,
+male_casualsuit06 (T-shirt + jeans) and shoes01, from ``--assets`` (default
+``../shared/fixtures/makehuman``, CC0), on MakeHuman's 163-bone default rig; MPFB2 finds
+them through its "second root" asset folder preference. Its dressed slider change is the
+macro slider plus ``HumanService.refit`` (what "Auto refit assets" runs), both timed; its
+panel defaults otherwise (shape-key pruning on: a jump across the midpoint loads targets
+from disk, which a drag step does not). Without ``--mpfb`` the MPFB2 column is the issue's
+MPFB2 2.0.17 figures (same kind of machine, wall clock, how its slider moved not stated):
+0.29 s create, 1.71 s dressed create, 42 ms bare change, 0.28 s dressed change.
 
 Goals (issue 13): a dressed, rigged human < 0.2 s and >= 5x MPFB2; a dressed slider change
 < 17 ms and >= 10x; a bare one < 5 ms and >= 8x. Medians over ``--repeat`` runs after one
-warm-up. Threads: numpy/BLAS and pykdtree may use all cores; on shared machines set
-OMP_NUM_THREADS=1 (the report prints the setting and the load average).
+warm-up. Threads: scipy's OpenBLAS (the body's macro sum) and pykdtree use all cores by
+default; on a loaded shared machine that costs far more than it saves, so set
+OMP_NUM_THREADS=1 there (the report prints the setting and the load average).
 """
 
 from __future__ import annotations
