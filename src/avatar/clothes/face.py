@@ -198,7 +198,7 @@ def _beard_flow(centre: np.ndarray):
     return flow
 
 
-def beard(body: AuthoringBody, count: int = 2400, length=(0.008, 0.015)) -> Piece:
+def beard(body: AuthoringBody, count: int = 3200, length=(0.008, 0.015)) -> Piece:
     """A short full beard: narrow strand cards rooted over ``facial_hair_mask(body,
     "beard")``, combed down the face, about a centimetre long, lying close to the skin and
     thinning out at its edges. The hair above the mouth (the moustache) and the rest are
@@ -213,7 +213,7 @@ def beard(body: AuthoringBody, count: int = 2400, length=(0.008, 0.015)) -> Piec
     return join([
         cards_on(body, keep & upper, flow, int(count * share), length, 0.0035, lift, fade=0.006),
         cards_on(body, keep & ~upper, flow, count - int(count * share), length, 0.0035, lift,
-                 seed=2, fade=0.012),
+                 seed=2, fade=0.008),
     ])  # fmt: skip
 
 
