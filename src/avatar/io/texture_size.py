@@ -4,7 +4,8 @@ A texture is never enlarged. By default (``size=None``) a part's textures are sc
 to the power of two nearest above ``DENSITY * sqrt(surface area)`` texels (at least
 ``MIN_SIZE``): about 0.25 mm^2 of surface a texel, so a whole body keeps its 1024-2048 px
 maps while an eyebrow (a few cm^2) gets 512 px, not the 1024 px normal map of its asset.
-A given ``size`` (e.g. 512, 1024, 2048 for a game engine) caps every texture's longer side.
+A given ``size`` (e.g. 512, 1024, 2048 for a game engine) caps that per-part side: a cap of
+1024 leaves an eyebrow's maps at its 512 px, it does not make them 1024 px.
 Materials shared by several parts stay shared (sized for the largest of them).
 """
 
@@ -48,14 +49,15 @@ def fit(image: np.ndarray, side: int) -> np.ndarray:
 
 
 def sized(parts: Sequence[MeshPart], size: int | None = None) -> list[MeshPart]:
-    """``parts`` with their materials' textures at most ``size`` px (default: per part,
-    ``needed_size``). Raises ValueError for a size under 1."""
+    """``parts`` with their materials' textures sized per part (``needed_size``) and at most
+    ``size`` px. Raises ValueError for a size under 1."""
     if size is not None and size < 1:
         raise ValueError(f"texture size must be a positive number of pixels, got {size}")
     sides: dict[int, int] = {}
     for part in parts:
         if part.material is not None:
-            side = size if size is not None else needed_size(part.mesh)
+            side = needed_size(part.mesh)
+            side = side if size is None else min(side, size)
             sides[id(part.material)] = max(sides.get(id(part.material), 0), side)
     fitted: dict[int, Material] = {}
     out = []
