@@ -17,12 +17,12 @@ import logging
 import math
 import os
 import threading
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.linalg import blas
 
 from avatar.body import assets, macros
 from avatar.body.attributes import ATTRIBUTES, basis
@@ -39,16 +39,27 @@ BODY_VERTICES = 13380  # vertices 0..13379 are skin; the rest is helper geometry
 FLAT_INDEX_CACHE = 128  # local targets whose flat scatter indices are kept (see _flat_index)
 
 
-def _axpy(a: float, x: np.ndarray, y: np.ndarray, first: int = 0, end: int | None = None) -> None:
-    """``y[first:end] += a * x[first:end]`` in place for float32 vectors, in one BLAS pass.
+_SCRATCH = threading.local()  # _axpy's product buffer, one per thread (grown on demand)
 
-    numpy would need a temporary and two passes; the fused multiply-add rounds once, so
-    results differ from numpy's by at most an ulp (~1e-8 m here).
+
+def _axpy(a: float, x: np.ndarray, y: np.ndarray, first: int = 0, end: int | None = None) -> None:
+    """``y[first:end] += a * x[first:end]`` in place for float32 vectors, single-threaded.
+
+    Two numpy passes through a per-thread scratch buffer (no allocation): BLAS ``saxpy``
+    would fuse them, but OpenBLAS runs it on every core, and on a loaded machine a thread
+    hand-off costs far more than the arithmetic (32 ms a call against 0.006 ms; issue 13).
+    The product is rounded to float32 before the add, so a sum may differ from a fused
+    multiply-add by an ulp (~1e-8 m here).
     """
     end = len(y) if end is None else end
-    z = blas.saxpy(x, y, n=end - first, a=a, offx=first, offy=first)
-    if z is not y:  # f2py works in place on a contiguous float32 y; keep correct regardless
-        y[...] = z
+    n = end - first
+    buffer = getattr(_SCRATCH, "buffer", None)
+    if buffer is None or len(buffer) < n:
+        buffer = _SCRATCH.buffer = np.empty(max(n, 1 << 16), dtype=np.float32)  # 256 kB
+    product = buffer[:n]
+    target = y[first:end]
+    np.multiply(x[first:end], np.float32(a), out=product)
+    np.add(target, product, out=target)
 
 
 # Level names of each macro group, as ``macros.level_weights`` names them. A group's level
@@ -84,11 +95,12 @@ class MacroSum:
 
     Memos are replaced whole, never mutated, and every result is a fresh array: ``shape``
     stays a pure function of its parameters. Results agree with a plain float32 sum within
-    float32 rounding (~1e-7 m); with ``contract`` off (``BodyModel.shared``) they are that
-    sum exactly, whatever bodies came before (reproducible datasets).
+    float32 rounding (~1e-7 m); with ``contract`` off (``BodyModel.shared``, outside
+    ``BodyModel.dragging``) they are that sum exactly, whatever bodies came before
+    (reproducible datasets): a contraction built earlier is then not used either.
     """
 
-    contract = True  # build the drag contraction (faster edits, history-dependent rounding)
+    contract = True  # build and use the drag contraction (faster edits, history-dependent rounding)
 
     def __init__(self, table: macros.MacroTable, dense: np.ndarray, spans: list[tuple[int, int]]):
         self.table = table
@@ -101,7 +113,7 @@ class MacroSum:
         """(V*3,) float32 sum of the macro targets for resolved ``values`` (a fresh array)."""
         key = tuple(float(values.get(k, d)) for k, (_, d) in macros.MACROS.items())
         last, con = self._last, self._contraction
-        if con is not None and con.others == _others(key, con.group):
+        if self.contract and con is not None and con.others == _others(key, con.group):
             flat = con.evaluate(values)  # cheap: no need to keep a copy of the result
             self._last = (key, None, con.group)
             return flat
@@ -217,8 +229,8 @@ class BodyModel:
         """This thread's model over the default assets, loaded once (a load takes ~50 ms,
         a body ~1 ms): what ``Human`` uses when given no model. Per thread because a model
         memoises its last shape; a change of ``AVATAR_ASSETS`` or ``AVATAR_CACHE`` loads
-        anew. Its shapes are exact sums (no drag contraction), so a body is bit for bit the
-        same whichever bodies were made before it."""
+        anew. Its shapes are exact sums (no drag contraction, except inside ``dragging``),
+        so a body is bit for bit the same whichever bodies were made before it."""
         key = (os.environ.get("AVATAR_ASSETS"), os.environ.get("AVATAR_CACHE"))
         cached = getattr(_SHARED, "model", None)
         if cached is None or cached[0] != key:
@@ -226,6 +238,19 @@ class BodyModel:
             model.macro_sum.contract = False
             _SHARED.model = cached = (key, model)
         return cached[1]
+
+    @contextmanager
+    def dragging(self) -> Iterator[BodyModel]:
+        """Within the block, shapes may use the drag contraction (``MacroSum``): a slider
+        dragged live costs ~4 axpys a step instead of a full macro sum, its bodies within
+        float32 rounding of the exact sum (~1e-7 m, depending on the bodies made before).
+        After it the model's setting is back (a shared model's sums exact again)."""
+        before = self.macro_sum.contract
+        self.macro_sum.contract = True
+        try:
+            yield self
+        finally:
+            self.macro_sum.contract = before
 
     def skin_weights(self, rig: str, bone_names: tuple[str, ...]) -> SkinWeights:
         """Skin weights of all base-mesh vertices over a rig's bones (built once per rig)."""
