@@ -201,7 +201,9 @@ def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
 
 # A dress's bodice: the tank top's cut on wider straps, its neckline scooped 9 cm below the
 # neck joint in front (well above the bust at every size) and 7 cm at the back.
-dress_bodice = strapped(0.02, armhole=0.056, front=0.09, back=0.07)
+# It ends 3 cm under the skirt's top (helper-skirt reaches 13 cm above the hip joints): a
+# longer bodice showed through the skirt at the back as a stray panel.
+dress_bodice = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
 
 
 def _dress(body: AuthoringBody) -> Piece:
@@ -213,7 +215,8 @@ def _dress(body: AuthoringBody) -> Piece:
     bodice = cut(body, faces, dress_bodice(ff, body.marks), 0.004, relax=RELAX)
     waist = float(np.percentile(bodice.vertices[:, 2], 1)) + 0.03
     bodice = banded(bodice, lambda p: np.where(p[:, 2] > waist, 0.012, 0.0))
-    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.004, 0.04))
+    # The skirt's top lies over the bodice's hem: 14 mm off (the bodice keeps 5 mm and more).
+    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04))
     return join([bound(body, bodice, faces), skirt_piece])
 
 
