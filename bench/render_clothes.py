@@ -33,24 +33,26 @@ BODIES = [  # child, teen, woman, man, heavy, muscular, elderly woman and man: a
 class Posed:
     """A dressed Human frozen in one frame: still meshes at their posed places."""
 
-    def __init__(self, human, outfit, matrices, exact: bool = True):
-        from avatar.clothes.library import parts
+    def __init__(self, human, matrices, exact: bool = True):
         from avatar.part import MeshPart
         from avatar.rig import skinning
 
         self.human, self.skeleton = human, human.skeleton
+        outfit = human.outfit
         body = skinning.linear_blend(human.vertices, human.weights, matrices)
         garments = outfit.frame(body, matrices, exact=exact)
         # Walk in place: the frame keeps the body where the rest pose stood.
         shift = np.zeros(3, np.float32)
         shift[:2] = (body[:13380] - human.vertices[:13380]).mean(axis=0)[:2]
+        rest = human.parts()  # body parts, then the outfit's garments
+        count = len(rest) - len(garments)
         self._parts = [
             MeshPart(p.name, p.mesh.with_vertices(body[human.part_vertices(p.name)] - shift),
                      p.material)
-            for p in human.parts()
+            for p in rest[:count]
         ] + [
             MeshPart(p.name, p.mesh.with_vertices(v - shift), p.material)
-            for p, v in zip(parts(outfit), garments, strict=True)
+            for p, v in zip(rest[count:], garments, strict=True)
         ]  # fmt: skip
 
     def parts(self):
@@ -58,13 +60,11 @@ class Posed:
 
 
 class Dressed:
-    """A Human with garments: its parts and the outfit's."""
+    """A dressed Human at rest: its parts (body, then garments, exact)."""
 
-    def __init__(self, human, outfit):
-        from avatar.clothes.library import parts
-
+    def __init__(self, human):
         self.human, self.skeleton = human, human.skeleton
-        self._parts = human.parts() + parts(outfit)
+        self._parts = human.parts()
 
     def parts(self):
         return self._parts
@@ -74,22 +74,19 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--samples", type=int, default=16)
     parser.add_argument("--out", default="docs/images")
-    parser.add_argument("--texture", type=int, default=512)
     parser.add_argument("--walk", action="store_true", help="mid-stride in the built-in walk")
     parser.add_argument("--name", default="clothes", help="file stem: NAME[_walk]_front.png")
     parser.add_argument("--views", default="front,back")
     args = parser.parse_args()
     from avatar.blender import render, scene
-    from avatar.clothes.library import dress, load_garment
     from avatar.human import Human
 
     chars = []
     for i, (params, names) in enumerate(BODIES):
-        human = Human(params)
-        outfit = dress(human.body, [load_garment(n, texture_size=args.texture) for n in names])
-        shown = Dressed(human, outfit)
+        human = Human(params).dressed(*names)  # raised onto its shoes' soles
+        shown = Dressed(human)
         if args.walk:
-            shown = Posed(human, outfit, _mid_stride(human))
+            shown = Posed(human, _mid_stride(human))
         chars.append(scene.Character(f"dressed{i}", shown.parts(), shown.skeleton))
     out = Path(args.out)
     stem = f"{args.name}_walk" if args.walk else args.name
