@@ -1,10 +1,14 @@
 """Property changes -> the library's in-place updates (``avatar.blender.live``).
 
 A slider (or a script) setting ``object.avatar.weight`` calls ``apply_params``: the body,
-skeleton and garments move at once, fitted the real-time way; a timer then settles the
-character (garments exact, skin texture of the new ethnicity/age/gender, measurements)
-once no change came for ``SETTLE_DELAY`` seconds. Headless scripts, where timers do not
-run, call ``settle_now`` (``bpy.ops.avatar.settle``).
+skeleton and garments move at once, fitted the real-time way, as a drag step
+(``avatar.blender.live.set_params(drag=True)``: the new joints shown through the pose, no
+edit-mode trip, so Blender re-evaluates this character only); a timer then settles the
+character (true rest bones, garments exact, skin texture of the new ethnicity/age/gender,
+measurements) once no change came for ``SETTLE_DELAY`` seconds. Headless scripts, where
+timers do not run, call ``settle_now`` (``bpy.ops.avatar.settle``). A character caught
+mid-drag by an undo, redo or file load is settled again; one is never saved mid-drag
+(handlers installed with the first change, ``install_handlers``).
 
 Errors inside a property callback cannot reach the status bar: they are logged and kept
 on the object (``ERROR_KEY``) for the Body panel to show; the character is left unchanged.
@@ -42,7 +46,7 @@ def apply_params(root) -> bool:
     from avatar.errors import AvatarError
 
     try:
-        live.set_params(root, root.avatar.params())
+        live.set_params(root, root.avatar.params(), drag=True)
     except AvatarError as exc:
         root[ERROR_KEY] = str(exc)
         log.error("Avatar: %s", exc)
@@ -56,8 +60,74 @@ def apply_params(root) -> bool:
 def schedule_settle(root) -> None:
     """Settle ``root``'s character once it has had no change for ``SETTLE_DELAY`` s."""
     _PENDING[root.name_full] = time.monotonic()
+    install_handlers()
     if not bpy.app.timers.is_registered(_settle_pending):
         bpy.app.timers.register(_settle_pending, first_interval=SETTLE_DELAY)
+
+
+def _dragging_roots() -> list:
+    """Characters whose pose stands in for their rest (a drag not settled yet)."""
+    from avatar.blender import live
+
+    return [o for o in bpy.data.objects if o.type == "ARMATURE" and live.is_dragging(o)]
+
+
+@bpy.app.handlers.persistent
+def _resume_settling(*_args) -> None:
+    """After an undo, redo or file load: a character caught mid-drag settles again (the
+    step restored may be one Blender pushed at the end of a drag, before its settle)."""
+    if not _registered():
+        return
+    for root in _dragging_roots():
+        schedule_settle(root)
+
+
+@bpy.app.handlers.persistent
+def _settle_before_save(*_args) -> None:
+    """A file is never written mid-drag: such characters settle first."""
+    if not _registered():
+        return
+    for root in _dragging_roots():
+        try:
+            settle_now(root)
+        except Exception as exc:  # noqa: BLE001 - a save handler must never raise into Blender
+            log.error("Avatar: settling %s before saving failed: %s", root.name, exc)
+
+
+_HANDLERS = (("undo_post", _resume_settling), ("redo_post", _resume_settling),
+             ("load_post", _resume_settling), ("save_pre", _settle_before_save))  # fmt: skip
+
+
+def _registered() -> bool:
+    """Whether the add-on is registered (a disabled one's handlers take themselves off)."""
+    if hasattr(bpy.types.Object, "avatar"):
+        return True
+    release()
+    return False
+
+
+def install_handlers() -> None:
+    """The undo/redo/load and save handlers above, once (replacing those of an earlier
+    load of this module, e.g. after the add-on was disabled and enabled again)."""
+    for kind, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, kind)
+        if handler in handlers:
+            continue
+        for old in [h for h in handlers if _same(h, handler)]:
+            handlers.remove(old)
+        handlers.append(handler)
+
+
+def release() -> None:
+    """Take this module's handlers off (unregister)."""
+    for kind, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, kind)
+        for old in [h for h in handlers if _same(h, handler)]:
+            handlers.remove(old)
+
+
+def _same(a, b) -> bool:
+    return getattr(a, "__module__", None) == b.__module__ and a.__name__ == b.__name__
 
 
 def _settle_pending():

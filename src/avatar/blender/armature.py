@@ -67,6 +67,66 @@ def set_rest(armature_obj: bpy.types.Object, skeleton: Skeleton) -> None:
         _place_edit_bones(armature_obj.data, skeleton)
 
 
+def show_rest_as_pose(armature_obj: bpy.types.Object, skeleton: Skeleton) -> None:
+    """Show ``skeleton``'s rest through the pose, without edit mode: each pose bone's
+    basis is set so that its pose matrix is the skeleton's rest matrix (head and
+    orientation; a bone keeps its drawn length, that of the armature's rest).
+
+    The armature's rest (``bone.matrix_local``) is not touched, so Blender re-evaluates
+    this armature and what depends on it, nothing else (an edit-mode trip makes it
+    re-evaluate every object in the scene). A mesh skinned to the armature would now be
+    deformed by each bone's pose times its inverse rest: the caller (``avatar.blender.
+    live``) turns those Armature modifiers off while the pose stands in for the rest, and
+    ``set_rest`` + ``reset_pose`` end it. Assumes Blender's default bone inheritance
+    (location, rotation and scale from the parent; no constraints), as Avatar makes bones.
+    """
+    pose_bones = armature_obj.pose.bones
+    n = len(pose_bones)
+    index = {name: j for j, name in enumerate(skeleton.names)}
+    order = np.array([index.get(b.name, -1) for b in pose_bones], dtype=np.int64)
+    if np.any(order < 0) or n != len(skeleton.names):
+        raise ValueError("the armature's bones are not the skeleton's")
+    flat = np.empty(16 * n, dtype=np.float32)
+    armature_obj.data.bones.foreach_get("matrix_local", flat)  # same order as pose bones
+    shown = np.empty((len(order), 4, 4), dtype=np.float64)  # Blender's rest, skeleton order
+    shown[order] = flat.reshape(n, 4, 4).transpose(0, 2, 1)
+    basis = pose_basis(shown, np.asarray(skeleton.rest, np.float64), skeleton.parents)[order]
+    pose_bones.foreach_set("matrix_basis", np.ascontiguousarray(
+        basis.transpose(0, 2, 1), dtype=np.float32).ravel())  # fmt: skip
+    armature_obj.update_tag(refresh={"DATA"})
+
+
+def pose_basis(rest: np.ndarray, target: np.ndarray, parents: Sequence[int]) -> np.ndarray:
+    """(J, 4, 4) each bone's pose basis that puts bones resting at ``rest`` (J, 4, 4,
+    armature space) at ``target`` (J, 4, 4): with Blender's pose rule ``P_j = P_p
+    (R_p^-1 R_j) B_j``, ``B_j = R_j^-1 R_p T_p^-1 T_j`` (``B_j = R_j^-1 T_j`` for a root).
+    ``parents`` (J,): parent index, -1 for a root."""
+    parents = np.asarray(parents, dtype=np.int64)
+    has_parent = parents >= 0
+    parent_rest = rest[np.where(has_parent, parents, 0)]
+    parent_target = target[np.where(has_parent, parents, 0)]
+    step = parent_rest @ np.linalg.inv(parent_target)  # R_p T_p^-1
+    step[~has_parent] = np.eye(4)
+    return np.linalg.inv(rest) @ step @ target
+
+
+def reset_pose(armature_obj: bpy.types.Object) -> None:
+    """Every pose bone's basis back to identity (the rest pose), in one array write."""
+    pose_bones = armature_obj.pose.bones
+    identity = np.tile(np.eye(4, dtype=np.float32).ravel(), len(pose_bones))
+    pose_bones.foreach_set("matrix_basis", identity)
+    armature_obj.update_tag(refresh={"DATA"})
+
+
+def pose_is_rest(armature_obj: bpy.types.Object, tolerance: float = 1e-6) -> bool:
+    """Whether every pose bone's basis is the identity (within ``tolerance``)."""
+    pose_bones = armature_obj.pose.bones
+    flat = np.empty(16 * len(pose_bones), dtype=np.float32)
+    pose_bones.foreach_get("matrix_basis", flat)
+    identity = np.tile(np.eye(4, dtype=np.float32).ravel(), len(pose_bones))
+    return bool(np.all(np.abs(flat - identity) <= tolerance))
+
+
 def _orthonormal(m: np.ndarray) -> np.ndarray:
     """(..., 4, 4) with each rotation part re-orthonormalised (SVD), so Blender accepts it
     exactly."""

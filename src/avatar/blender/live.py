@@ -27,7 +27,7 @@ import logging
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import bpy
 import numpy as np
@@ -56,33 +56,58 @@ SETTLED_KEY = "avatar_settled"  # on the root: 1 once garments and skin are exac
 TEMPLATE_KEY = "avatar_template"  # on template meshes: their cache key
 
 
-@dataclass(frozen=True, eq=False)
 class Geometry:
-    """What a recipe looks like at rest: the shaped body on its rig, and its outfit."""
+    """What a recipe looks like at rest: the shaped body on its rig, and its outfit.
 
-    recipe: Recipe
-    body: Body
-    outfit: Outfit | None
+    vertices: (19158, 3) float32 the shaped body (helpers included), feet on z = 0.
+    The skeleton is placed when ``body`` is first asked for (a bare body's slider step
+    never needs it).
+    """
+
+    def __init__(self, recipe: Recipe, vertices: np.ndarray, model: BodyModel,
+                 outfit: Outfit | None = None):  # fmt: skip
+        self.recipe = recipe
+        self.vertices = vertices
+        self.model = model
+        self.outfit = outfit
+
+    @cached_property
+    def body(self) -> Body:
+        """The shaped body on the recipe's rig (skeleton placed, skin weights)."""
+        rig = self.recipe.rig
+        skeleton = _rig_definition(self.model, rig).skeleton(self.vertices)
+        weights = self.model.skin_weights(rig, tuple(skeleton.names))
+        return Body(self.vertices, skeleton, weights, self.model, rig)
 
     def part_vertices(self, part: str) -> np.ndarray:
         """(n, 3) float32 the vertices of a body part ("body", "eyes") in its mesh's order."""
-        return self.body.vertices[_part_index(self.body.model, part)]
+        return self.vertices[_part_index(self.model, part)]
 
 
 def geometry(
-    recipe: Recipe, model: BodyModel | None = None, exact: bool = True, dress: bool = True
+    recipe: Recipe,
+    model: BodyModel | None = None,
+    exact: bool = True,
+    dress: bool = True,
+    drag: bool = False,
 ) -> Geometry:
     """The body, skeleton and garments of ``recipe``, as ``Human.from_recipe`` realises
     them (``exact`` outfit), or fitted the real-time way (``exact=False``); ``dress=False``
-    leaves the garments out (``outfit`` None)."""
+    leaves the garments out (``outfit`` None). ``drag``: a step of a slider being dragged:
+    the body's macro sum may use the model's drag contraction (within float32 rounding of
+    the exact sum) and the garments their cached lookup."""
     model = model or BodyModel.shared()
-    vertices = shaped.rest_vertices(model, model.resolve(recipe.params))
-    skeleton = _rig_definition(model, recipe.rig).skeleton(vertices)
-    body = Body(vertices, skeleton, model.skin_weights(recipe.rig, tuple(skeleton.names)),
-                model, recipe.rig)  # fmt: skip
-    garments = [garment(entry, model) for entry in recipe.clothes]
-    outfit = library.dress(body, garments, exact=exact) if garments and dress else None
-    return Geometry(recipe, body, outfit)
+    values = model.resolve(recipe.params)
+    if drag:
+        with model.dragging():
+            vertices = shaped.rest_vertices(model, values)
+    else:
+        vertices = shaped.rest_vertices(model, values)
+    geo = Geometry(recipe, vertices, model)
+    if recipe.clothes and dress:
+        geo.outfit = library.dress(geo.body, garments(recipe.clothes, model, cached=drag),
+                                   exact=exact)  # fmt: skip
+    return geo
 
 
 @lru_cache(maxsize=16)
@@ -96,15 +121,38 @@ def _part_index(model: BodyModel, part: str) -> np.ndarray:
 
 
 _USER_GARMENTS: dict[tuple[str, float], Garment] = {}
+# A recipe's garments as last looked up: (entries, model) -> Garments. A drag step uses
+# them as they are (no path parsed, no file stat'ed: 5 garments were ~15 lookups a step);
+# every other change looks them up again, so an edited .mhclo is read at the next settle.
+_GARMENT_SETS: dict[tuple[tuple[str, ...], BodyModel], list[Garment]] = {}
+
+
+def garments(entries: Sequence[str], model: BodyModel | None = None,
+             cached: bool = False) -> list[Garment]:  # fmt: skip
+    """The Garments of a recipe's clothes entries (``garment`` each); ``cached``: as last
+    looked up for the same entries, when they were."""
+    model = model or BodyModel.shared()
+    key = (tuple(entries), model)
+    found = _GARMENT_SETS.get(key) if cached else None
+    if found is None:
+        found = [garment(entry, model) for entry in entries]
+        if len(_GARMENT_SETS) >= 16:
+            _GARMENT_SETS.clear()
+        _GARMENT_SETS[key] = found
+    return found
 
 
 def garment(entry: str, model: BodyModel | None = None) -> Garment:
     """The Garment of a recipe entry: built-ins from the library's cache, a user's
-    ``.mhclo`` read once per file version (its anchors then stay cached with it)."""
+    ``.mhclo`` read once per file version (its anchors then stay cached with it).
+    Raises AvatarError when the file is gone."""
     source = library.find_garment(entry)
     if source in builtin.BY_NAME:
         return library.load_garment(source, model=model)
-    key = (os.path.abspath(source), os.path.getmtime(source))
+    try:
+        key = (os.path.abspath(source), os.path.getmtime(source))
+    except OSError as exc:
+        raise AvatarError(f"{source}: no such garment file") from exc
     if key not in _USER_GARMENTS:
         _USER_GARMENTS[key] = library.load_garment(source, model=model)
     return _USER_GARMENTS[key]
@@ -247,18 +295,26 @@ def template_mesh(key: str, part: MeshPart, bone_names: Sequence[str] | None) ->
 # ---------------------------------------------------------------------------- updating
 
 
-def set_params(root: bpy.types.Object, params: Mapping[str, float]) -> Geometry:
+def set_params(root: bpy.types.Object, params: Mapping[str, float], drag: bool = False) -> Geometry:
     """Give the character ``root`` heads these body parameters, in place (real-time fit;
-    ``settle`` after). Raises AvatarError for a bad name or value, before changing anything."""
+    ``settle`` after). Raises AvatarError for a bad name or value, before changing anything.
+
+    drag: a step of a slider being dragged (what the extension's properties pass): a
+    rigged character's new rest is shown through its pose (``show_rest_as_pose``; its
+    Armature modifiers off meanwhile, so body and garments show their new rest exactly)
+    instead of a trip through edit mode, which makes Blender re-evaluate every object in
+    the scene. ``settle``, or any change without ``drag``, writes the true rest bones and
+    ends it. A posed or animated character always gets its rest bones written."""
     recipe = recipe_of(root)
     human = Human(params, recipe.rig, recipe=recipe)  # validates: nothing changed yet
-    geo = geometry(human.recipe, human.model, dress=False)
-    garments = _follow(root, geo)
-    if garments is None and human.recipe.clothes:
-        geo = geometry(human.recipe, human.model, exact=False)
-    write(root, geo, garments)
+    geo = geometry(human.recipe, human.model, dress=False, drag=drag)
+    moved = _follow(root, geo, drag)
+    if moved is None and human.recipe.clothes:
+        found = garments(human.recipe.clothes, human.model, cached=drag)
+        geo.outfit = library.dress(geo.body, found, exact=False)
+    write(root, geo, moved, drag=drag)
     root[RECIPE_KEY] = json.dumps(human.to_recipe())
-    root[SETTLED_KEY] = int(not human.recipe.clothes)
+    root[SETTLED_KEY] = int(not human.recipe.clothes and not is_dragging(root))
     return geo
 
 
@@ -276,7 +332,9 @@ class _Fitted:
 _LAST: dict[str, _Fitted] = {}  # root name -> what its garments were last written for
 
 
-def _follow(root: bpy.types.Object, geo: Geometry) -> dict[str, np.ndarray] | None:
+def _follow(
+    root: bpy.types.Object, geo: Geometry, drag: bool = False
+) -> dict[str, np.ndarray] | None:
     """Garment vertices for a slider step: each garment as it is now, moved by how its
     binding's fit moved between the last body and ``geo``'s (one linear fit a garment,
     ~0.5 ms). The clearance the last fit resolved is carried along; ``settle`` then fits
@@ -289,19 +347,18 @@ def _follow(root: bpy.types.Object, geo: Geometry) -> dict[str, np.ndarray] | No
         return None
     parts = part_objects(root)
     body = parts.get("body")
-    skin = last.vertices[_part_index(geo.body.model, "body")]
+    skin = last.vertices[_part_index(geo.model, "body")]
     if body is None or not np.array_equal(read_positions(body), skin):
         return None
     out = {}
-    for entry in recipe.clothes:
-        g = garment(entry, geo.body.model)
+    for g in garments(recipe.clothes, geo.model, cached=drag):
         obj = parts.get(g.name)
         if obj is None:
             return None
         before = last.points.get(g.name)
         if before is None:
             before = fit(g.binding, last.vertices)
-        after = last.points[g.name] = fit(g.binding, geo.body.vertices)
+        after = last.points[g.name] = fit(g.binding, geo.vertices)
         current = read_positions(obj)
         delta = after - before
         if len(current) % len(delta):
@@ -309,7 +366,7 @@ def _follow(root: bpy.types.Object, geo: Geometry) -> dict[str, np.ndarray] | No
         out[g.name] = current + np.tile(delta, (len(current) // len(delta), 1))
     # The fits just made belong to the new body: ``write`` keeps them for the next step.
     last.points = {n: last.points[n] for n in out}
-    last.vertices = geo.body.vertices
+    last.vertices = geo.vertices
     return out
 
 
@@ -361,11 +418,15 @@ def _swap_material(obj: bpy.types.Object, new: bpy.types.Material) -> None:
 
 
 def write(
-    root: bpy.types.Object, geo: Geometry, garments: Mapping[str, np.ndarray] | None = None
+    root: bpy.types.Object,
+    geo: Geometry,
+    garments: Mapping[str, np.ndarray] | None = None,
+    drag: bool = False,
 ) -> None:
     """Write ``geo`` into the character's objects: body, eyes, garments (``geo.outfit``'s,
-    or ``garments``: name -> (M, 3)), rest bones. Raises AvatarError, before writing, when
-    the character's parts do not match it."""
+    or ``garments``: name -> (M, 3)), rest bones (through the pose with ``drag``: see
+    ``set_params``). Raises AvatarError, before writing, when the character's parts do
+    not match it."""
     parts = part_objects(root)
     if garments is None:
         garments = {g.name: g.mesh.vertices for g in geo.outfit or ()}
@@ -380,11 +441,93 @@ def write(
     for obj, vertices in writes:
         write_vertices(obj, vertices)
     if root.type == "ARMATURE":
-        armature_bridge.set_rest(root, geo.body.skeleton)
+        _write_rest(root, geo, drag)
     last = _LAST.get(root.name_full)
-    points = last.points if last is not None and last.vertices is geo.body.vertices else {}
-    _LAST[root.name_full] = _Fitted(geo.body.vertices, geo.recipe.clothes, geo.recipe.rig,
+    points = last.points if last is not None and last.vertices is geo.vertices else {}
+    _LAST[root.name_full] = _Fitted(geo.vertices, geo.recipe.clothes, geo.recipe.rig,
                                     points)  # fmt: skip
+
+
+# ---------------------------------------------------------------------------- drags
+
+DRAG_KEY = "avatar_drag"  # on an armature root: 1 while its pose stands in for its rest
+DEFORM_OFF_KEY = "avatar_deform_off"  # on a part: Armature modifiers a drag switched off
+
+
+def _write_rest(root: bpy.types.Object, geo: Geometry, drag: bool) -> None:
+    """The armature's rest bones for ``geo``: shown through the pose during a drag (the
+    first drag step switches the parts' Armature modifiers off), else written as rest."""
+    skeleton = geo.body.skeleton
+    if drag and _can_show_rest_as_pose(root):
+        if not is_dragging(root):
+            _switch_deform(root, on=False)
+            root[DRAG_KEY] = 1
+        armature_bridge.show_rest_as_pose(root, skeleton)
+        return
+    armature_bridge.set_rest(root, skeleton)
+    _leave_drag(root)
+
+
+def _can_show_rest_as_pose(root: bpy.types.Object) -> bool:
+    """Whether a drag may show ``root``'s rest through its pose: the pose is the rest (or
+    already stands in for it) and nothing else drives it (action, NLA, drivers)."""
+    if is_dragging(root):
+        return True
+    if root.data.pose_position != "POSE":
+        return False
+    anim = root.animation_data
+    if anim is not None and (anim.action is not None or len(anim.nla_tracks) or len(anim.drivers)):
+        return False
+    return armature_bridge.pose_is_rest(root)
+
+
+def is_dragging(root: bpy.types.Object) -> bool:
+    """Whether ``root``'s pose stands in for its rest (a drag not settled yet)."""
+    return bool(root.get(DRAG_KEY, 0))
+
+
+def end_drag(root: bpy.types.Object) -> None:
+    """Write the true rest bones of ``root``'s recipe now if a drag left them shown through
+    the pose (one edit-mode trip), the pose back to rest, the Armature modifiers on;
+    nothing otherwise. For anything about to pose, export or save the character
+    (``settle`` does it too, with the exact garments)."""
+    if root.type != "ARMATURE" or not is_dragging(root):
+        return
+    geo = geometry(recipe_of(root), dress=False)
+    armature_bridge.set_rest(root, geo.body.skeleton)
+    _leave_drag(root)
+
+
+def _leave_drag(root: bpy.types.Object) -> None:
+    if not is_dragging(root):
+        return
+    armature_bridge.reset_pose(root)
+    _switch_deform(root, on=True)
+    del root[DRAG_KEY]
+
+
+def _switch_deform(root: bpy.types.Object, on: bool) -> None:
+    """The Armature modifiers on ``root`` of the meshes under it: off (those showing in
+    the viewport, remembered on their object), or back on (those remembered)."""
+    for obj in root.children_recursive:
+        if obj.type != "MESH":
+            continue
+        if on:
+            names = obj.get(DEFORM_OFF_KEY)
+            if names is None:
+                continue
+            for name in names:
+                modifier = obj.modifiers.get(name)
+                if modifier is not None:
+                    modifier.show_viewport = True
+            del obj[DEFORM_OFF_KEY]
+            continue
+        off = [m for m in obj.modifiers
+               if m.type == "ARMATURE" and m.object == root and m.show_viewport]  # fmt: skip
+        for modifier in off:
+            modifier.show_viewport = False
+        if off:
+            obj[DEFORM_OFF_KEY] = [m.name for m in off]
 
 
 def write_vertices(obj: bpy.types.Object, vertices: np.ndarray) -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from avatar.blender import live
 from avatar.rig.skeleton import Animation
 
 CORRECTION_PREFIX = "correction"  # garment shape keys baked for a motion (export.character)
@@ -19,6 +20,7 @@ def set_pose(armature_obj: bpy.types.Object, pose: Animation, frame: int = 0) ->
     """Pose ``armature_obj``'s bones as ``pose`` frame ``frame`` (rotations (T, J, 4) wxyz,
     translations (T, J, 3) in each bone's rest frame); bones the pose does not name go to
     rest. Returns how many bones the pose set."""
+    live.end_drag(armature_obj)  # true rest bones first, if a slider drag left them posed
     by_name = {n: j for j, n in enumerate(pose.bone_names)}
     rotations = np.asarray(pose.rotations[frame], dtype=np.float64)
     locations = np.asarray(pose.translations[frame], dtype=np.float64)
@@ -39,6 +41,7 @@ def set_pose(armature_obj: bpy.types.Object, pose: Animation, frame: int = 0) ->
 
 def clear_pose(armature_obj: bpy.types.Object) -> None:
     """Every pose bone back to its rest (identity rotation, no location, unit scale)."""
+    live.end_drag(armature_obj)  # true rest bones first, if a slider drag left them posed
     for bone in armature_obj.pose.bones:
         _rest(bone)
     armature_obj.update_tag()

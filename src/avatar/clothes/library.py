@@ -127,16 +127,38 @@ def _builtin(name: str, texture_size: int, model: BodyModel | None) -> Garment:
     return builtin.build(builtin.BY_NAME[name], authoring_body(model), texture_size)
 
 
+# find_garment's answers: (name or path, folders, $AVATAR_CLOTHES_PATH) -> the .mhclo path
+# found. A live slider step validates its recipe's garments every time; a hit costs one
+# stat of the file found (a name may have needed a scan of every user folder).
+_FOUND: dict[tuple[str, tuple[str, ...], str], str] = {}
+_FOUND_SIZE = 256
+
+
 def find_garment(
     name_or_path: str | os.PathLike[str], folders: Iterable[str | os.PathLike[str]] = ()
 ) -> str:
     """Where a garment comes from, checked without building it: a built-in name, or the
     ``.mhclo`` path of a file or of a user asset found by name (``folders``,
     ``$AVATAR_CLOTHES_PATH``). Raises ParameterError naming close matches for an unknown
-    name, AvatarError for a missing ``.mhclo`` file."""
+    name, AvatarError for a missing ``.mhclo`` file. Answers are remembered while the file
+    found still exists (a renamed or added asset with the same name is not looked for)."""
     text = str(name_or_path)
     if text in builtin.BY_NAME:
         return text
+    where = tuple(str(f) for f in folders)
+    key = (text, where, os.environ.get(ENV_PATH, ""))
+    found = _FOUND.get(key)
+    if found is not None and os.path.isfile(found):
+        return found
+    found = _find_user_garment(text, where)
+    if len(_FOUND) >= _FOUND_SIZE:
+        _FOUND.clear()
+    _FOUND[key] = found
+    return found
+
+
+def _find_user_garment(text: str, folders: tuple[str, ...]) -> str:
+    """``find_garment`` for anything but a built-in name (no memo)."""
     path = Path(text)
     if path.is_file():
         return text
