@@ -81,19 +81,42 @@ def show_rest_as_pose(armature_obj: bpy.types.Object, skeleton: Skeleton) -> Non
     (location, rotation and scale from the parent; no constraints), as Avatar makes bones.
     """
     pose_bones = armature_obj.pose.bones
-    n = len(pose_bones)
-    index = {name: j for j, name in enumerate(skeleton.names)}
-    order = np.array([index.get(b.name, -1) for b in pose_bones], dtype=np.int64)
-    if np.any(order < 0) or n != len(skeleton.names):
-        raise ValueError("the armature's bones are not the skeleton's")
+    pose_order, bone_order = _bone_orders(armature_obj, tuple(skeleton.names))
+    n = len(pose_order)
     flat = np.empty(16 * n, dtype=np.float32)
-    armature_obj.data.bones.foreach_get("matrix_local", flat)  # same order as pose bones
-    shown = np.empty((len(order), 4, 4), dtype=np.float64)  # Blender's rest, skeleton order
-    shown[order] = flat.reshape(n, 4, 4).transpose(0, 2, 1)
-    basis = pose_basis(shown, np.asarray(skeleton.rest, np.float64), skeleton.parents)[order]
+    armature_obj.data.bones.foreach_get("matrix_local", flat)
+    shown = np.empty((n, 4, 4), dtype=np.float64)  # Blender's rest, in skeleton order
+    shown[bone_order] = flat.reshape(n, 4, 4).transpose(0, 2, 1)
+    target = np.asarray(skeleton.rest, np.float64)
+    basis = pose_basis(shown, target, skeleton.parents)[pose_order]
     pose_bones.foreach_set("matrix_basis", np.ascontiguousarray(
         basis.transpose(0, 2, 1), dtype=np.float32).ravel())  # fmt: skip
     armature_obj.update_tag(refresh={"DATA"})
+
+
+_ORDERS: dict[tuple[int, tuple[str, ...]], tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _bone_orders(armature_obj: bpy.types.Object, names: tuple[str, ...]):
+    """(skeleton index of each pose bone, of each bone of ``armature.bones``), read once per
+    armature and skeleton (a drag step then reads no bone name; a spot check of three
+    names catches an armature that changed under the same address)."""
+    pose_bones = armature_obj.pose.bones
+    key = (armature_obj.data.as_pointer(), names)
+    found = _ORDERS.get(key)
+    if found is not None and len(pose_bones) == len(names):
+        pose_order = found[0]
+        if all(pose_bones[k].name == names[pose_order[k]] for k in (0, len(names) // 2, -1)):
+            return found
+    index = {name: j for j, name in enumerate(names)}
+    orders = tuple(np.array([index.get(b.name, -1) for b in bones], dtype=np.int64)
+                   for bones in (pose_bones, armature_obj.data.bones))  # fmt: skip
+    if len(pose_bones) != len(names) or any(np.any(o < 0) for o in orders):
+        raise ValueError("the armature's bones are not the skeleton's")
+    if len(_ORDERS) >= 32:
+        _ORDERS.clear()
+    _ORDERS[key] = found = (orders[0], orders[1])
+    return found
 
 
 def pose_basis(rest: np.ndarray, target: np.ndarray, parents: Sequence[int]) -> np.ndarray:

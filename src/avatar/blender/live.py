@@ -97,12 +97,11 @@ def geometry(
     the body's macro sum may use the model's drag contraction (within float32 rounding of
     the exact sum) and the garments their cached lookup."""
     model = model or BodyModel.shared()
-    values = model.resolve(recipe.params)
-    if drag:
+    if drag:  # (shape resolves and validates the parameters)
         with model.dragging():
-            vertices = shaped.rest_vertices(model, values)
+            vertices = shaped.rest_vertices(model, recipe.params)
     else:
-        vertices = shaped.rest_vertices(model, values)
+        vertices = shaped.rest_vertices(model, recipe.params)
     geo = Geometry(recipe, vertices, model)
     if recipe.clothes and dress:
         geo.outfit = library.dress(geo.body, garments(recipe.clothes, model, cached=drag),
