@@ -157,10 +157,12 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
     fade = tree.nodes.new("ShaderNodeMapRange")
     fade.location = (-300, -750)
     tree.links.new(split.outputs["Y"], fade.inputs["Value"])
-    level = float(bsdf.inputs["Specular IOR Level"].default_value)
+    # Blender 4.0 renamed the Principled BSDF's "Specular" to "Specular IOR Level".
+    specular = bsdf.inputs.get("Specular IOR Level") or bsdf.inputs["Specular"]
+    level = float(specular.default_value)
     fade.inputs["From Min"].default_value, fade.inputs["From Max"].default_value = 0.0, 0.5
     fade.inputs["To Min"].default_value, fade.inputs["To Max"].default_value = level, 0.4 * level
-    tree.links.new(fade.outputs["Result"], bsdf.inputs["Specular IOR Level"])
+    tree.links.new(fade.outputs["Result"], specular)
 
 
 def allow_transparent_layers(scene: bpy.types.Scene, layers: int = 64) -> None:
