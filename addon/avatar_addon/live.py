@@ -106,9 +106,15 @@ def _registered() -> bool:
     return False
 
 
+_INSTALLED = {"done": False}  # install_handlers ran (every change asks: keep it cheap)
+
+
 def install_handlers() -> None:
     """The undo/redo/load and save handlers above, once (replacing those of an earlier
     load of this module, e.g. after the add-on was disabled and enabled again)."""
+    if _INSTALLED["done"]:
+        return
+    _INSTALLED["done"] = True
     for kind, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, kind)
         if handler in handlers:
@@ -120,6 +126,7 @@ def install_handlers() -> None:
 
 def release() -> None:
     """Take this module's handlers off (unregister)."""
+    _INSTALLED["done"] = False
     for kind, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, kind)
         for old in [h for h in handlers if _same(h, handler)]:

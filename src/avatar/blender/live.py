@@ -307,11 +307,12 @@ def set_params(root: bpy.types.Object, params: Mapping[str, float], drag: bool =
     recipe = recipe_of(root)
     human = Human(params, recipe.rig, recipe=recipe)  # validates: nothing changed yet
     geo = geometry(human.recipe, human.model, dress=False, drag=drag)
-    moved = _follow(root, geo, drag)
+    parts = part_objects(root)  # O(objects in the file): once a step
+    moved = _follow(root, geo, drag, parts)
     if moved is None and human.recipe.clothes:
         found = garments(human.recipe.clothes, human.model, cached=drag)
         geo.outfit = library.dress(geo.body, found, exact=False)
-    write(root, geo, moved, drag=drag)
+    write(root, geo, moved, drag=drag, parts=parts)
     root[RECIPE_KEY] = json.dumps(human.to_recipe())
     root[SETTLED_KEY] = int(not human.recipe.clothes and not is_dragging(root))
     return geo
@@ -332,7 +333,10 @@ _LAST: dict[str, _Fitted] = {}  # root name -> what its garments were last writt
 
 
 def _follow(
-    root: bpy.types.Object, geo: Geometry, drag: bool = False
+    root: bpy.types.Object,
+    geo: Geometry,
+    drag: bool = False,
+    parts: Mapping[str, bpy.types.Object] | None = None,
 ) -> dict[str, np.ndarray] | None:
     """Garment vertices for a slider step: each garment as it is now, moved by how its
     binding's fit moved between the last body and ``geo``'s (one linear fit a garment,
@@ -344,7 +348,7 @@ def _follow(
     if last is None or not recipe.clothes or (last.clothes, last.rig) != (recipe.clothes,
                                                                           recipe.rig):  # fmt: skip
         return None
-    parts = part_objects(root)
+    parts = part_objects(root) if parts is None else parts
     body = parts.get("body")
     skin = last.vertices[_part_index(geo.model, "body")]
     if body is None or not np.array_equal(read_positions(body), skin):
@@ -421,12 +425,13 @@ def write(
     geo: Geometry,
     garments: Mapping[str, np.ndarray] | None = None,
     drag: bool = False,
+    parts: Mapping[str, bpy.types.Object] | None = None,
 ) -> None:
     """Write ``geo`` into the character's objects: body, eyes, garments (``geo.outfit``'s,
     or ``garments``: name -> (M, 3)), rest bones (through the pose with ``drag``: see
-    ``set_params``). Raises AvatarError, before writing, when the character's parts do
-    not match it."""
-    parts = part_objects(root)
+    ``set_params``). ``parts``: ``part_objects(root)`` when the caller has it. Raises
+    AvatarError, before writing, when the character's parts do not match it."""
+    parts = part_objects(root) if parts is None else parts
     if garments is None:
         garments = {g.name: g.mesh.vertices for g in geo.outfit or ()}
     missing = [n for n in [*PART_GROUPS, *garments] if n not in parts]
