@@ -10,6 +10,7 @@ the rig, garments (``dressed``), each with close matches in the error.
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 from collections.abc import Mapping, Sequence
@@ -25,7 +26,7 @@ from avatar.body import shaped
 from avatar.body.assets import RIG_NAMES
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
-from avatar.clothes import face, footing, library
+from avatar.clothes import face, footing, library, variants
 from avatar.clothes.asset import material_from_file
 from avatar.clothes.outfit import Outfit
 from avatar.errors import ParameterError, unknown_name
@@ -43,7 +44,9 @@ from avatar.rig.skinning import SkinWeights
 
 log = logging.getLogger(__name__)
 
-RECIPE_VERSION = 2  # 2: MakeHuman looks (eyes, skin, expression, ...), hide_covered, folders
+RECIPE_VERSION = 3  # 2: MakeHuman looks (eyes, skin, expression, ...), hide_covered, folders
+# 3: garment_options (fabric/colour variants of built-ins)
+MHM_GARMENT = "avatar-garment"  # .mhm line: avatar-garment <entry> <options as JSON>
 BODY_PART_GROUPS = PART_GROUPS
 # MakeHuman's eye materials (eyes/materials/<stem>.mhmat) -> Avatar's iris colours.
 EYE_COLOURS = {"brown": "brown", "brownlight": "hazel", "lightbrown": "hazel", "hazel": "hazel",
@@ -55,7 +58,7 @@ DEFAULT_SKIN_MATERIAL = "skins/default.mhmat"  # MakeHuman's untextured default 
 WEARABLE = ("clothes", "hair", "eyebrows", "eyelashes")  # .mhm proxies Avatar dresses in
 _FIELDS = ("version", "params", "rig", "pose", "clothes", "motion", "name", "eye_material",
            "skin_material", "expression", "hide_covered", "subdivide", "folders",
-           "mhm")  # fmt: skip
+           "mhm", "garment_options")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,8 @@ class Recipe:
         ``$AVATAR_CLOTHES_PATH`` for the garments and materials named here.
     mhm: other ``.mhm`` statements kept verbatim as (key, rest of line): camera, tags, the
         eyes proxy, proxies and materials Avatar does not use, assets not found.
+    garment_options: {clothes entry: its variant} for worn built-ins in another colour or
+        fabric, e.g. {"tshirt": {"colour": "navy"}} (``avatar.clothes.variants``).
     """
 
     params: dict[str, float] = field(default_factory=dict)
@@ -93,6 +98,7 @@ class Recipe:
     subdivide: bool = False
     folders: tuple[str, ...] = ()
     mhm: tuple[tuple[str, str], ...] = ()
+    garment_options: dict[str, dict[str, str]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -110,7 +116,12 @@ class Recipe:
             "subdivide": self.subdivide,
             "folders": list(self.folders),
             "mhm": [list(kv) for kv in self.mhm],
+            "garment_options": self.worn_options(),
         }
+
+    def worn_options(self) -> dict[str, dict[str, str]]:
+        """``garment_options`` of the garments worn (a garment taken off forgets its own)."""
+        return {k: dict(v) for k, v in self.garment_options.items() if k in self.clothes and v}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Recipe:
@@ -137,6 +148,7 @@ class Recipe:
             subdivide=bool(data.get("subdivide", False)),
             folders=tuple(str(f) for f in data.get("folders") or ()),
             mhm=tuple(_statement(kv) for kv in data.get("mhm") or ()),
+            garment_options=_options(data.get("garment_options")),
         )
 
     @classmethod
@@ -180,13 +192,32 @@ class Recipe:
                      "faces are the expression/* parameters)", path,
                      text["expression"])  # fmt: skip
         hide = character.flags.get("clothesHideFaces")
+        options = {}
+        for key, rest in list(character.other):
+            if key == MHM_GARMENT:
+                worn, _, payload = rest.partition(" ")
+                try:
+                    options[worn] = json.loads(payload)
+                except ValueError:
+                    log.warning("%s: bad %s line %r: ignored", path, MHM_GARMENT, rest)
+                character.other.remove((key, rest))
         return cls(params={**character.modifiers, **character.avatar_params},
                    rig=rig or character.rig or "default", pose=text.get("pose"),
                    clothes=tuple(dict.fromkeys(clothes)), name=text.get("name", ""),
                    eye_material=eye_material, skin_material=text.get("skinMaterial"),
                    expression=text.get("expression"), hide_covered=hide,
                    subdivide=character.flags.get("subdivide", False), folders=names,
-                   mhm=tuple(kept + list(character.other)))  # fmt: skip
+                   mhm=tuple(kept + list(character.other)),
+                   garment_options=_options(options))  # fmt: skip
+
+
+def _options(data: Any) -> dict[str, dict[str, str]]:
+    """A recipe's ``garment_options`` as plain text mappings (checked by ``Human``)."""
+    if not data:
+        return {}
+    if not isinstance(data, Mapping) or not all(isinstance(v, Mapping) for v in data.values()):
+        raise ParameterError(f"garment_options must map garments to options, not {data!r}")
+    return {str(k): {str(o): v for o, v in opts.items()} for k, opts in data.items()}
 
 
 def _text(value: Any) -> str | None:
@@ -219,7 +250,8 @@ class Human:
         values = self.model.resolve(params)  # validates names and ranges up front
         self.recipe = replace(recipe or Recipe(), params=values, rig=rig)
         for garment in self.recipe.clothes:  # names, without building the garments
-            library.find_garment(garment, self.recipe.folders)
+            source = library.find_garment(garment, self.recipe.folders)
+            variants.check(source, self.recipe.garment_options.get(garment))
 
     @classmethod
     def from_recipe(
@@ -407,7 +439,8 @@ class Human:
         """The recipe's garments fitted on this body (``avatar.clothes.outfit.Outfit``),
         every vertex outside the body (``exact``: this is what exports and renders use)."""
         return library.dress(self.body, list(self.recipe.clothes), exact=True,
-                             folders=self.recipe.folders)  # fmt: skip
+                             folders=self.recipe.folders,
+                             options=self.recipe.garment_options)  # fmt: skip
 
     def dressed(self, *garments: str) -> Human:
         """A copy of this human also wearing ``garments`` (library names or .mhclo paths).
@@ -516,6 +549,8 @@ class Human:
         for key, text in (("pose", r.pose), ("expression", r.expression)):
             if text:
                 out.text[key] = text
+        for worn_entry, options in r.worn_options().items():
+            out.other.append((MHM_GARMENT, f"{worn_entry} {json.dumps(options, sort_keys=True)}"))
         if r.hide_covered is not None:
             out.flags["clothesHideFaces"] = r.hide_covered
         out.flags["subdivide"] = r.subdivide

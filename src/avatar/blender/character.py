@@ -28,7 +28,7 @@ from mathutils import Vector
 
 from avatar import export
 from avatar import motion as library
-from avatar.blender import live
+from avatar.blender import garment_looks, live
 from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
 from avatar.blender import scene as stage
@@ -60,7 +60,9 @@ def create(
     exact: fit garments exactly now (else the real-time fit; ``live.settle`` later).
     Raises AvatarError (bad parameters, missing assets, ...) before touching the scene.
     """
-    return live.create(recipe, name, tuple(location), rigged=rigged, exact=exact)
+    built = live.create(recipe, name, tuple(location), rigged=rigged, exact=exact)
+    garment_looks.apply(built.root)  # fabric/colour variants (garment_options)
+    return built
 
 
 def realise(recipe: Mapping[str, object]) -> Human:
@@ -108,6 +110,7 @@ def _restyle(root: bpy.types.Object, recipe: Recipe) -> stage.CharacterObjects:
     live.refresh_materials(root, human)
     root[RECIPE_KEY] = json.dumps(human.to_recipe())
     root[live.SETTLED_KEY] = 1
+    garment_looks.apply(root)
     return objects_of(root)
 
 
@@ -155,7 +158,9 @@ def _rebuild(root: bpy.types.Object, recipe, motion):
 
     def build() -> stage.CharacterObjects:
         if animation is None:
-            return live.create(human.recipe, name, location, rigged, collection, exact=True)
+            built = live.create(human.recipe, name, location, rigged, collection, exact=True)
+            garment_looks.apply(built.root)
+            return built
         character = export.character(human, animation, name=name, location=location)
         built = stage.build_character(character, collection)
         built.root[live.RIGGED_KEY] = 1

@@ -386,17 +386,27 @@ BY_NAME = {s.name: s for s in SPECS}
 
 def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
     """A built-in Garment from its recipe on the authoring body."""
-    piece = spec.make(body)
-    if piece.layout is not None:
+    return assemble(spec, spec.make(body), body, texture_size)
+
+
+def look(spec: Spec, layout, texture_size: int = 1024) -> Material:
+    """The Material of a built-in in ``spec``'s fabric and colour; ``layout``: its piece's
+    panel layout (``Piece.layout``, None for a tiled fabric). A fabric or colour variant is
+    ``look(dataclasses.replace(spec, fabric=..., colour=...), layout)``: no geometry."""
+    if layout is not None:
         # A panel texture covers the whole garment once (not a tile): twice the texels.
-        material = tailored.material(spec.name, spec.fabric, spec.colour, piece.layout,
-                                     min(2 * texture_size, 4096))  # fmt: skip
-    elif spec.look is not None:
-        material = spec.look(spec, texture_size)
-    elif spec.category in ("hair", "face"):
-        material = textures.hair_material(spec, texture_size)
-    else:
-        material = fabrics.material(spec.fabric, spec.colour, texture_size, name=spec.name)
+        return tailored.material(spec.name, spec.fabric, spec.colour, layout,
+                                 min(2 * texture_size, 4096))  # fmt: skip
+    if spec.look is not None:
+        return spec.look(spec, texture_size)
+    if spec.category in ("hair", "face"):
+        return textures.hair_material(spec, texture_size)
+    return fabrics.material(spec.fabric, spec.colour, texture_size, name=spec.name)
+
+
+def assemble(spec: Spec, piece: Piece, body: AuthoringBody, texture_size: int = 1024) -> Garment:
+    """A built-in Garment from its already cut ``piece`` (``spec.make(body)``)."""
+    material = look(spec, piece.layout, texture_size)
     # Face proxies are drawn on the skin; holes there would show through, so they hide nothing.
     delete = covered_skin(body, piece.mesh) if spec.collide else np.zeros(0, np.int32)
     return Garment(

@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import os
 import uuid
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
 from avatar.body.model import BodyModel
 from avatar.body.shaped import Body, default_body
-from avatar.clothes import builtin, fitting
+from avatar.clothes import builtin, fitting, variants
 from avatar.clothes.asset import read_garment
 from avatar.clothes.authoring import AuthoringBody
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
@@ -123,8 +124,25 @@ def authoring_body(model: BodyModel | None = None) -> AuthoringBody:
 
 
 @lru_cache(maxsize=64)
+def _piece(name: str, model: BodyModel | None):
+    """A built-in's cut piece (geometry, binding, panel layout), cut once per model."""
+    return builtin.BY_NAME[name].make(authoring_body(model))
+
+
+@lru_cache(maxsize=64)
 def _builtin(name: str, texture_size: int, model: BodyModel | None) -> Garment:
-    return builtin.build(builtin.BY_NAME[name], authoring_body(model), texture_size)
+    spec = builtin.BY_NAME[name]
+    return builtin.assemble(spec, _piece(name, model), authoring_body(model), texture_size)
+
+
+@lru_cache(maxsize=64)
+def _variant(name: str, options: tuple[tuple[str, str], ...], texture_size: int,
+             model: BodyModel | None) -> Garment:  # fmt: skip
+    """A built-in in a fabric/colour variant: the default's geometry and binding (the same
+    arrays), a material of its own, made once per (garment, variant)."""
+    spec = variants.spec(name, dict(options))
+    look = builtin.look(spec, _piece(name, model).layout, texture_size)
+    return replace(_builtin(name, texture_size, model), material=look)
 
 
 # find_garment's answers: (name or path, folders, $AVATAR_CLOTHES_PATH) -> the .mhclo path
@@ -176,15 +194,20 @@ def load_garment(
     folders: Iterable[str | os.PathLike[str]] = (),
     texture_size: int = 1024,
     model: BodyModel | None = None,
+    options: Mapping[str, object] | None = None,
 ) -> Garment:
     """A Garment by built-in name, by a user asset's name, or from a ``.mhclo`` path.
 
     model: the body model built-ins are cut from (default ``BodyModel.shared()``).
-    Raises ParameterError (with close matches) for an unknown name, FormatError for a
-    broken file.
+    options: a built-in's fabric/colour variant, e.g. {"colour": "navy"} (``variants``).
+    Raises ParameterError (with close matches) for an unknown name or option, FormatError
+    for a broken file.
     """
     source = find_garment(name_or_path, folders)
+    checked = variants.check(source, options)
     if source in builtin.BY_NAME:
+        if checked and not variants.is_default(source, checked):
+            return _variant(source, tuple(sorted(checked.items())), texture_size, model)
         return _builtin(source, texture_size, model)
     return read_garment(source)
 
@@ -194,11 +217,14 @@ def dress(
     garments: Sequence[Garment | str] = DEFAULT_OUTFIT,
     exact: bool = False,
     folders: Iterable[str | os.PathLike[str]] = (),
+    options: Mapping[str, Mapping[str, object]] | None = None,
 ) -> Outfit:
     """Fit garments (Garment records, or names/paths: ``load_garment``) on a shaped body
-    (``Human.body``); see ``fitting.dress``."""
+    (``Human.body``); see ``fitting.dress``. options: {entry: a built-in's variant}."""
+    options = options or {}
     loaded = [
-        g if isinstance(g, Garment) else load_garment(g, folders, model=body.model)
+        g if isinstance(g, Garment)
+        else load_garment(g, folders, model=body.model, options=options.get(str(g)))
         for g in garments
     ]
     return fitting.dress(body, loaded, exact)

@@ -44,6 +44,7 @@ FABRICS = {
     "rubber": Fabric("rubber", "grain", 90, 0.8, 0.75, 0.05),
     "calf": Fabric("calf", "grain", 220, 0.25, 0.35, 0.04),  # smooth shoe leather
     "cord": Fabric("cord", "twill", 40, 2.5, 0.9, 0.3),
+    "linen": Fabric("linen", "plain", 110, 1.6, 0.9, 0.22),  # coarse, slubby plain weave
 }
 
 COLOURS = {
@@ -56,8 +57,22 @@ COLOURS = {
     "black hair": (0.012, 0.01, 0.01), "tan": (0.33, 0.17, 0.07), "cream": (0.75, 0.72, 0.64),
     "charcoal": (0.06, 0.06, 0.065), "burgundy": (0.22, 0.02, 0.04),
     "auburn hair": (0.14, 0.045, 0.018), "grey hair": (0.36, 0.35, 0.34),
-    "dark brown": (0.07, 0.035, 0.018),
+    "dark brown": (0.07, 0.035, 0.018), "light indigo": (0.16, 0.25, 0.45),
+    "dark indigo": (0.02, 0.035, 0.11), "light grey": (0.6, 0.61, 0.62),
 }  # fmt: skip
+
+
+def rgb(colour) -> np.ndarray:
+    """(3,) linear RGB of a colour: a name in COLOURS, an sRGB hex text ``"#rrggbb"`` (a
+    custom colour as a colour picker gives it) or three linear floats in [0, 1]."""
+    if isinstance(colour, str):
+        if colour.startswith("#"):
+            code = colour[1:]
+            srgb_bytes = np.array([int(code[i : i + 2], 16) for i in (0, 2, 4)]) / 255.0
+            return np.where(srgb_bytes <= 0.04045, srgb_bytes / 12.92,
+                            ((srgb_bytes + 0.055) / 1.055) ** 2.4)  # fmt: skip
+        return np.asarray(COLOURS[colour], np.float64)
+    return np.asarray(colour, np.float64)
 
 
 def _grid(size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -141,10 +156,10 @@ def maps(fabric_name: str, size: int = 1024, seed: int = 0):
 
 def colour_map(fabric_name: str, colour, size: int = 1024, seed: int = 0) -> np.ndarray:
     """(S, S, 3) uint8 sRGB colour texture of a fabric in a linear RGB colour (or a name)."""
-    rgb = np.asarray(COLOURS.get(colour, colour) if isinstance(colour, str) else colour)
+    linear = rgb(colour)
     h, _, _ = maps(fabric_name, size, seed)
     shade = 1.0 + FABRICS[fabric_name].contrast * h
-    return srgb(rgb[None, None, :] * shade[..., None])
+    return srgb(linear[None, None, :] * shade[..., None])
 
 
 def material(

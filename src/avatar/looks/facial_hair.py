@@ -51,7 +51,7 @@ def stubble_material(spec, size: int = 1024) -> Material:
     """Stubble in the spec's hair colour: blended (glTF ``BLEND``) over the skin, so the
     stubs and the shadow between them darken it without hard edges."""
     alpha = stubble_alpha(size)
-    rgb = np.asarray(fabrics.COLOURS[spec.colour], np.float32) * 0.8
+    rgb = fabrics.rgb(spec.colour).astype(np.float32) * 0.8
     colour = np.concatenate([np.broadcast_to(fabrics.srgb(rgb), (size, size, 3)),
                              alpha[..., None]], -1)  # fmt: skip
     return Material(

@@ -136,8 +136,7 @@ class Canvas:
 
 
 def _colour(value) -> np.ndarray:
-    return np.asarray(fabrics.COLOURS.get(value, value) if isinstance(value, str) else value,
-                      np.float64)  # fmt: skip
+    return fabrics.rgb(value)  # a name, "#rrggbb" or linear RGB
 
 
 def weave(fabric: fabrics.Fabric, size: int, px_per_metre: float) -> np.ndarray:

@@ -182,7 +182,7 @@ def hair_material(spec, size: int = 1024) -> Material:
     else:
         alpha, mode, shade = strand_alpha(size), "MASK", strand_shade(size)
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
-    rgb = np.asarray(fabrics.COLOURS[spec.colour])[None, None, :] * shade[..., None]
+    rgb = fabrics.rgb(spec.colour)[None, None, :] * shade[..., None]
     if spec.name.startswith("eyebrows"):
         # Brow hairs are coarser and darker than scalp hair of the same colour: blond brows
         # a shade deeper, so they read against fair skin.
