@@ -283,3 +283,31 @@ def test_a_bare_body_drags_exactly(installed, assets, empty_scene):
         fresh = _fresh(root)
         body = live.part_objects(root)["body"]
         np.testing.assert_allclose(_shown(body), fresh.mesh.vertices, atol=BODY_TOLERANCE)
+
+
+def test_affine_inverse_matches_lapack(rng):
+    from avatar.blender.armature import affine_inverse
+
+    m = np.tile(np.eye(4), (20, 1, 1))
+    m[:, :3, :4] = rng.standard_normal((20, 3, 4))  # shear and scale too
+    np.testing.assert_allclose(affine_inverse(m), np.linalg.inv(m), atol=1e-9)
+    np.testing.assert_allclose(affine_inverse(m[3]), np.linalg.inv(m[3]), atol=1e-9)
+
+
+def test_pose_basis_puts_each_bone_at_its_target(rng):
+    """Blender's pose rule P_j = P_p (R_p^-1 R_j) B_j, applied down the tree, gives T_j."""
+    from bridge_fixtures import bone_matrix, skeleton
+
+    from avatar.blender.armature import pose_basis
+
+    skel = skeleton(rng)
+    rest = np.asarray(skel.rest, np.float64)
+    heads = rest[:, :3, 3] + rng.normal(0, 0.05, (len(rest), 3))  # moved joints, new rolls
+    target = np.stack([bone_matrix(h, h + rng.normal(0, 1, 3), rng.normal(0, 1, 3))
+                       for h in heads])  # fmt: skip
+    basis = pose_basis(rest, target, skel.parents)
+    posed = np.zeros_like(rest)
+    for j, p in enumerate(skel.parents):  # parents come first
+        offset = rest[j] if p < 0 else np.linalg.inv(rest[p]) @ rest[j]
+        posed[j] = (np.eye(4) if p < 0 else posed[p]) @ offset @ basis[j]
+    np.testing.assert_allclose(posed, target, atol=1e-9)

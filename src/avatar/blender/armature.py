@@ -128,9 +128,25 @@ def pose_basis(rest: np.ndarray, target: np.ndarray, parents: Sequence[int]) -> 
     has_parent = parents >= 0
     parent_rest = rest[np.where(has_parent, parents, 0)]
     parent_target = target[np.where(has_parent, parents, 0)]
-    step = parent_rest @ np.linalg.inv(parent_target)  # R_p T_p^-1
+    step = parent_rest @ affine_inverse(parent_target)  # R_p T_p^-1
     step[~has_parent] = np.eye(4)
-    return np.linalg.inv(rest) @ step @ target
+    return affine_inverse(rest) @ step @ target
+
+
+def affine_inverse(m: np.ndarray) -> np.ndarray:
+    """(..., 4, 4) inverses of affine matrices (last row 0 0 0 1), written out (adjugate
+    by cross products): ``np.linalg.inv`` goes through LAPACK, which OpenBLAS runs on
+    every core; on a loaded machine that was ~1 ms for 163 bones instead of ~0.05."""
+    a = m[..., :3, :3]
+    rows = [a[..., 0, :], a[..., 1, :], a[..., 2, :]]
+    adjugate = np.stack([np.cross(rows[1], rows[2]), np.cross(rows[2], rows[0]),
+                         np.cross(rows[0], rows[1])], axis=-1)  # fmt: skip
+    det = np.sum(rows[0] * adjugate[..., :, 0], axis=-1)[..., None, None]
+    out = np.zeros(m.shape, dtype=np.float64)
+    out[..., :3, :3] = adjugate / det
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", out[..., :3, :3], m[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
 
 
 def reset_pose(armature_obj: bpy.types.Object) -> None:
