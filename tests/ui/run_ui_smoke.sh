@@ -38,7 +38,7 @@ GARMENT2_DX="${AVATAR_UI_GARMENT2_DX:-146}"
 GARMENT2_DY="${AVATAR_UI_GARMENT2_DY:-420}"
 DRESS_HEADER_DY="${AVATAR_UI_DRESS_HEADER_DY:-43}"  # click: fold the Dress panel
 APPLY_DX="${AVATAR_UI_APPLY_DX:-102}"       # Motion > Apply, with Body and Dress folded
-APPLY_DY="${AVATAR_UI_APPLY_DY:-214}"
+APPLY_DY="${AVATAR_UI_APPLY_DY:-183}"
 
 cleanup() {
   [[ -n "${BLENDER_PID:-}" ]] && kill "$BLENDER_PID" 2>/dev/null || true
@@ -52,8 +52,9 @@ wait_for() {  # wait_for FILE SECONDS
   echo "timed out waiting for $1" >&2; tail -20 "$OUT/blender.log" >&2; return 1
 }
 
-shot() {  # shot NAME: screenshot + state.json (kept as state-NAME.json) through the driver
-  rm -f "$OUT/done-$1"; : > "$OUT/request-shot-$1"; wait_for "$OUT/done-$1" 60
+shot() {  # shot NAME [SECONDS]: screenshot + state.json (kept as state-NAME.json) through the
+  # driver, which answers once Blender is idle again (default: within 60 s)
+  rm -f "$OUT/done-$1"; : > "$OUT/request-shot-$1"; wait_for "$OUT/done-$1" "${2:-60}"
   cp "$OUT/state.json" "$OUT/state-$1.json"
 }
 
@@ -176,7 +177,7 @@ shot motion-panel
 click $((LEFT + APPLY_DX)) $((TOP + APPLY_DY))
 for _ in $(seq 20); do   # retarget + garment bake: poll until the action is there
   sleep 3
-  shot after-motion
+  shot after-motion 300   # Blender answers once Apply (retarget + garment bake) is done
   grep -q '"actions": {}' "$OUT/state.json" || break
 done
 : > "$OUT/request-quit"
