@@ -54,9 +54,10 @@ WHEEL_CACHE = ROOT / "build" / "wheel-cache"
 
 log = logging.getLogger("build")
 
-# What the library imports and Blender lacks. pykdtree is optional: where no wheel exists for a
-# target the clothes code uses SciPy's k-d tree (avatar.geometry.nearest).
-BUNDLED = ("scipy", "pillow", "pykdtree", "tqdm", "pygltflib")
+# What the library imports and Blender lacks (python-osc: the Mocap panel's VMC source, which
+# every live source imports). pykdtree is optional: where no wheel exists for a target the
+# clothes code uses SciPy's k-d tree (avatar.geometry.nearest).
+BUNDLED = ("scipy", "pillow", "pykdtree", "tqdm", "pygltflib", "python-osc")
 OPTIONAL = frozenset({"pykdtree"})
 # In Blender's own Python already (and Blender's copy must win: bpy is built against it).
 BLENDER_SHIPS = frozenset({"numpy"})

