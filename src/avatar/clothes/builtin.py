@@ -384,9 +384,11 @@ SPECS = [
 BY_NAME = {s.name: s for s in SPECS}
 
 
-def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024) -> Garment:
-    """A built-in Garment from its recipe on the authoring body."""
-    return assemble(spec, spec.make(body), body, texture_size)
+def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024,
+          piece: Piece | None = None) -> Garment:  # fmt: skip
+    """A built-in Garment from its recipe on the authoring body; ``piece``: its already cut
+    piece (``spec.make(body)``), e.g. one shared with its fabric/colour variants."""
+    return assemble(spec, spec.make(body) if piece is None else piece, body, texture_size)
 
 
 def look(spec: Spec, layout, texture_size: int = 1024) -> Material:

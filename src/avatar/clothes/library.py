@@ -132,7 +132,7 @@ def _piece(name: str, model: BodyModel | None):
 @lru_cache(maxsize=64)
 def _builtin(name: str, texture_size: int, model: BodyModel | None) -> Garment:
     spec = builtin.BY_NAME[name]
-    return builtin.assemble(spec, _piece(name, model), authoring_body(model), texture_size)
+    return builtin.build(spec, authoring_body(model), texture_size, _piece(name, model))
 
 
 @lru_cache(maxsize=64)
