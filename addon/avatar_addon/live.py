@@ -99,11 +99,9 @@ _HANDLERS = (("undo_post", _resume_settling), ("redo_post", _resume_settling),
 
 
 def _registered() -> bool:
-    """Whether the add-on is registered (a disabled one's handlers take themselves off)."""
-    if hasattr(bpy.types.Object, "avatar"):
-        return True
-    release()
-    return False
+    """Whether the add-on is registered: a disabled one's handlers do nothing (they are
+    not taken off here, while Blender walks their list; ``release`` does that)."""
+    return hasattr(bpy.types.Object, "avatar")
 
 
 _INSTALLED = {"done": False}  # install_handlers ran (every change asks: keep it cheap)
