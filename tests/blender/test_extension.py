@@ -233,6 +233,8 @@ def test_wear_and_take_off_by_name(human):
     assert bpy.ops.avatar.wear(name="jeans") == {"FINISHED"}
     assert {"tshirt", "jeans"} <= set(live.part_objects(human))
     _assert_matches_fresh_human(human)
+    assert bpy.ops.avatar.wear(name="shoes") == {"FINISHED"}  # the body rises onto the soles
+    _assert_matches_fresh_human(human)
     human.avatar.weight = 0.8  # the new garments follow the body too
     bpy.ops.avatar.settle()
     _assert_matches_fresh_human(human)

@@ -39,7 +39,7 @@ from avatar.blender.scene import CharacterObjects, new_collection
 from avatar.body import shaped
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
-from avatar.clothes import builtin, library
+from avatar.clothes import builtin, footing, library
 from avatar.clothes.binding import fit
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.errors import AvatarError
@@ -102,6 +102,9 @@ def geometry(
             vertices = shaped.rest_vertices(model, recipe.params)
     else:
         vertices = shaped.rest_vertices(model, recipe.params)
+    # On built-in shoes the body stands on their soles, as Human raises it (clothes.footing).
+    vertices[:, 2] += np.float32(footing.sole_height(vertices, recipe.clothes, recipe.folders,
+                                                     model))  # fmt: skip
     geo = Geometry(recipe, vertices, model)
     if recipe.clothes and dress:
         geo.outfit = library.dress(geo.body, garments(recipe.clothes, model, cached=drag),
