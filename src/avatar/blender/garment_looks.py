@@ -19,7 +19,7 @@ import bpy
 
 from avatar.blender import live
 from avatar.blender import materials as material_bridge
-from avatar.clothes import library, variants
+from avatar.clothes import builtin, library, variants
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
 
@@ -37,6 +37,8 @@ def apply(root: bpy.types.Object) -> int:
     swapped = 0
     for entry in recipe.clothes:
         source = library.find_garment(entry, recipe.folders)
+        if source not in builtin.BY_NAME:  # only built-ins have variants; a user's .mhclo
+            continue  # keeps the material it was made with (and is not read again here)
         garment = library.load_garment(source, recipe.folders,
                                        options=recipe.garment_options.get(entry))  # fmt: skip
         obj = parts.get(garment.name)
