@@ -192,7 +192,10 @@ def test_killed_run_resumes_to_the_same_labels(dataset, tmp_path):
         time.sleep(0.2)
     os.killpg(proc.pid, signal.SIGKILL)  # the command and its worker, mid-sample
     proc.wait()
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    # resumed on two workers: each renders with its share of the cores (one Cycles thread
+    # here), which must not change a label byte
+    done = subprocess.run([*cmd, "--workers", "2"], capture_output=True, text=True,
+                          timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-2000:]
     lines = (out / "manifest.jsonl").read_text().splitlines()
     assert sorted(json.loads(line)["id"] for line in lines) == [0, 1, 2]
@@ -202,6 +205,15 @@ def test_killed_run_resumes_to_the_same_labels(dataset, tmp_path):
             a = (clean / "samples" / f"{i:08d}" / name).read_bytes()
             b = (out / "samples" / f"{i:08d}" / name).read_bytes()
             assert a == b, (i, name)
+
+
+def test_workers_share_the_cores_out_among_their_renders():
+    from avatar.dataset import runner
+
+    assert runner.render_threads(1, cores=2) == 0  # one worker: Cycles takes every core
+    assert runner.render_threads(2, cores=2) == 1
+    assert runner.render_threads(3, cores=8) == 2
+    assert runner.render_threads(4, cores=2) == 1  # never zero threads
 
 
 @pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs Ray (the ray extra)")

@@ -119,6 +119,14 @@ class Stage:
                     if image.users == 0:
                         bpy.data.images.remove(image)
 
+    @staticmethod
+    def set_threads(threads: int) -> None:
+        """Render on ``threads`` CPU threads (0: Blender's default, one per core)."""
+        scene_render = bpy.context.scene.render
+        scene_render.threads_mode = "FIXED" if threads > 0 else "AUTO"
+        if threads > 0:
+            scene_render.threads = threads
+
     def render_rgb(self, path: Path, engine: str, samples: int, transparent: bool) -> Path:
         """The picture, 8-bit RGBA PNG (alpha 0 where transparent and nothing was hit)."""
         scene = bpy.context.scene

@@ -34,7 +34,8 @@ def render(config: Config, out: Path, todo: list[int], workers: int) -> Iterable
         _render_one
     )
     try:
-        pending = {task.remote(config, i, str(out)): i for i in todo}
+        # a task holds one CPU of its node: one Cycles thread, so a node's tasks share its cores
+        pending = {task.remote(config, i, str(out), 1): i for i in todo}
         while pending:
             ready, _ = ray.wait(list(pending), num_returns=1)
             for ref in ready:

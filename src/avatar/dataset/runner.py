@@ -111,6 +111,7 @@ Result = tuple[int, dict | None, str | None]  # (index, manifest entry, error)
 
 def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable[Result]:
     """Render ``todo`` on ``workers`` processes, yielding results as they finish."""
+    threads = render_threads(workers)
     context = multiprocessing.get_context("spawn")  # a fresh Blender per worker
     pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=context,
                                max_tasks_per_child=config.render.recycle_every)  # fmt: skip
@@ -120,7 +121,7 @@ def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable
         while queue or pending:
             while queue and len(pending) < 2 * max(1, workers):  # a short queue per worker
                 index = queue.pop()
-                pending[pool.submit(_render_one, config, index, str(out))] = index
+                pending[pool.submit(_render_one, config, index, str(out), threads)] = index
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
             for future in finished:
                 index = pending.pop(future)
@@ -132,8 +133,19 @@ def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _render_one(config: Config, index: int, out: str) -> Result:
-    """Worker side: render one sample; errors come back as text (never kill the pool)."""
+def render_threads(workers: int, cores: int | None = None) -> int:
+    """Cycles threads for each of ``workers`` processes sharing this machine's cores; 0 for a
+    single worker (Cycles' own choice: every core). Each worker's Cycles would otherwise
+    start a thread per core, so two workers on two cores fought over both and a second
+    worker added a third of a worker's rate instead of nearly one."""
+    if workers <= 1:
+        return 0
+    return max(1, (cores or os.cpu_count() or 1) // workers)
+
+
+def _render_one(config: Config, index: int, out: str, threads: int = 0) -> Result:
+    """Worker side: render one sample with ``threads`` Cycles threads (0: all cores);
+    errors come back as text (never kill the pool)."""
     # Blender writes its user config at import: a private folder, not the user's
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
     if "bpy" not in sys.modules:
@@ -145,7 +157,7 @@ def _render_one(config: Config, index: int, out: str) -> Result:
     from avatar.dataset.worker import render_sample
 
     try:
-        return index, render_sample(config, index, out), None
+        return index, render_sample(config, index, out, threads), None
     except AvatarError as exc:
         return index, None, str(exc)
 

@@ -25,8 +25,9 @@ log = logging.getLogger(__name__)
 _STAGE: list = []  # this worker process's Blender stage, made on its first sample
 
 
-def render_sample(config: Config, index: int, out: str | Path) -> dict:
-    """Render and write sample ``index``; returns its manifest entry."""
+def render_sample(config: Config, index: int, out: str | Path, threads: int = 0) -> dict:
+    """Render and write sample ``index`` (Cycles on ``threads`` threads, 0: every core);
+    returns its manifest entry. Labels do not depend on the threads."""
     from avatar.blender import labels as blender_labels
 
     out = Path(out)
@@ -42,6 +43,7 @@ def render_sample(config: Config, index: int, out: str | Path) -> dict:
         _STAGE.append(blender_labels.Stage())
     stage = _STAGE[0]
     stage.build(items, spec.camera, spec.light, spec.background)
+    stage.set_threads(threads)
     tmp = store.temp_dir(out, index)
     tmp.mkdir(parents=True, exist_ok=True)
     transparent = spec.background["kind"] == "images"
