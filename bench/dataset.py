@@ -4,7 +4,9 @@
 
 1. label overhead: samples/s with every label against the anchor, a bare Cycles render of
    the same scenes (same people, camera, lights; RGB only), on one worker in-process;
-2. workers: 1 -> 2 local worker processes (efficiency = rate(2) / (2 * rate(1)));
+2. workers: 1 -> 2 local worker processes, each rendering on its share of the cores
+   (efficiency = rate(2) / (2 * rate(1)), the single worker on one core's share, as each
+   of the two has), and the speed-up of 2 workers over 1 worker on every core;
 3. engines: local vs Ray (a local cluster), same samples;
 4. --rss N: the worker's resident memory over N samples (one process, no recycling), the
    curve printed every 10 samples: it should stay within 10% of its value after 50.
@@ -55,11 +57,19 @@ def bare_vs_labelled(args, folder: Path) -> tuple[float, float]:
     return bare / args.count, labelled / args.count
 
 
-def rate(args, workers: int, engine: str, folder: Path) -> float:
+def rate(args, workers: int, engine: str, folder: Path, threads: int | None = None) -> float:
+    """Samples/s of a fresh run; ``threads``: each local worker's Cycles threads (default:
+    the runner's share of the cores)."""
     c = _config(args, args.count)
+    shares = runner.render_threads
+    if threads is not None:  # the parent decides the workers' threads: set it there
+        runner.render_threads = lambda workers, cores=None: threads  # type: ignore[assignment]
     shutil.rmtree(folder, ignore_errors=True)
     start = time.perf_counter()
-    report = runner.run(c, folder, workers=workers, engine=engine)
+    try:
+        report = runner.run(c, folder, workers=workers, engine=engine)
+    finally:
+        runner.render_threads = shares  # type: ignore[assignment]
     assert not report.failed, report.failed
     return args.count / (time.perf_counter() - start)
 
@@ -113,10 +123,14 @@ def _throughput(args, root: Path) -> None:
     bare, labelled = bare_vs_labelled(args, root / "inproc")
     print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
           f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}%")
+    share = max(1, (os.cpu_count() or 1) // 2)
+    one_share = rate(args, 1, "local", root / "w1s", threads=share)
     one = rate(args, 1, "local", root / "w1")
     two = rate(args, 2, "local", root / "w2")
-    print(f"local engine: 1 worker {one:.3f} samples/s, 2 workers {two:.3f} samples/s, "
-          f"efficiency {two / (2 * one):.2f}")  # fmt: skip
+    print(f"local engine: 1 worker on {share} thread(s) {one_share:.3f} samples/s, "
+          f"2 workers on {share} each {two:.3f} samples/s: efficiency "
+          f"{two / (2 * one_share):.2f}; 1 worker on every core {one:.3f} samples/s: "
+          f"2 workers {two / one:.2f}x that")  # fmt: skip
     if not args.skip_ray:
         ray = rate(args, 2, "ray", root / "ray")
         print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
