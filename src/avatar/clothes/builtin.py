@@ -65,13 +65,21 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0) -> Piece:
     return bound(body, mesh, faces)
 
 
-def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False) -> Piece:
+def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
+          hug: float | None = None, under: np.ndarray | None = None,
+          gap: float = 0.004) -> Piece:  # fmt: skip
     """A skirt from ``helper-skirt`` down to ``bottom_z``, swinging as one (``blend_sides``);
     ``tailor``: its own panel texture with side seams, a waistband (geometry too), a
-    centre-back zip and a stitched hem band."""
+    centre-back zip and a stitched hem band. ``hug``: m off the skin the skirt keeps down
+    to the hip joints, flaring only below them (``tailoring.sit_on_hips``), outside the
+    points ``under`` (M, 3) of what it is worn over."""
     faces = body.group_faces("helper-skirt")
     centre_z = body.vertices[faces].mean(axis=1)[:, 2]
     mesh = cut(body, faces, centre_z > bottom_z, ease, RELAX, loose=True)
+    if hug is not None:
+        points = tailoring.sit_on_hips(body, mesh.vertices, hug, float(body.marks.hip[:, 2].mean()),
+                                       under=under, gap=gap)  # fmt: skip
+        mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
     if not tailor:
         return tailoring.blend_sides(body, bound(body, mesh, faces), "helper-skirt")
     panels = tailoring.Panels(mesh, tailoring.SKIRT_PANELS, tailoring.body_axis(body.marks))
@@ -203,6 +211,7 @@ def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
 # neck joint in front (well above the bust at every size) and 7 cm at the back.
 # It ends 3 cm under the skirt's top (helper-skirt reaches 13 cm above the hip joints): a
 # longer bodice showed through the skirt at the back as a stray panel.
+DRESS_HUG = 0.009  # m the dress's skirt keeps off the skin at the waist and hips
 dress_bodice = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
 
 
@@ -215,8 +224,10 @@ def _dress(body: AuthoringBody) -> Piece:
     bodice = cut(body, faces, dress_bodice(ff, body.marks), 0.004, relax=RELAX)
     waist = float(np.percentile(bodice.vertices[:, 2], 1)) + 0.03
     bodice = banded(bodice, lambda p: np.where(p[:, 2] > waist, 0.012, 0.0))
-    # The skirt's top lies over the bodice's hem: 14 mm off (the bodice keeps 5 mm and more).
-    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04))
+    # The skirt's top lies over the bodice's hem (the bodice keeps 4 mm), sits on the hips
+    # and flares below them.
+    skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04),
+                         hug=DRESS_HUG, under=bodice.vertices, gap=0.01)
     return join([bound(body, bodice, faces), skirt_piece])
 
 

@@ -388,6 +388,50 @@ def straight_legs(body: AuthoringBody, points: np.ndarray, hang: float, start: f
     return out
 
 
+def skin_offset(body: AuthoringBody, points: np.ndarray, k: int = 6,
+                ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """((N,) signed metres off the skin, (N, 3) unit outward directions) of points (N, 3):
+    the distance above the tangent planes of the ``k`` nearest skin vertices, weighted by
+    nearness (smooth where one nearest vertex would step from vertex to vertex)."""
+    dist, i = body.skin_tree.query(points, k=k)
+    w = 1.0 / (dist + 0.005)
+    w /= w.sum(axis=1, keepdims=True)
+    n = body.skin_normals[i].astype(np.float64)
+    above = np.einsum("nkd,nkd->nk", points[:, None] - body.vertices[i], n)
+    normal = np.einsum("nk,nkd->nd", w, n)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-9)
+    return np.einsum("nk,nk->n", w, above), normal
+
+
+def sit_on_hips(body: AuthoringBody, points: np.ndarray, ease: float, hip_z: float,
+                fall: float = 0.12, under: np.ndarray | None = None,
+                gap: float = 0.004) -> np.ndarray:  # fmt: skip
+    """(N, 3) skirt points with everything above ``hip_z`` laid ``ease`` m off the skin
+    (the waist and hips carry a skirt: it sits on them), easing over ``fall`` m below
+    ``hip_z`` back to the points' own, flared positions, so the flare starts below the
+    hip instead of standing out from the waist (a helper skirt stands 1.5-3 cm off the
+    hips of slim and heavy bodies, a ridge and pleats round the hips). ``under``: (M, 3)
+    points of a layer the skirt lies over (a dress's bodice): the skirt keeps ``gap`` m
+    outside the nearest of them."""
+    out = points.astype(np.float64).copy()
+    t = np.clip((hip_z - out[:, 2]) / fall, 0, 1)
+    w = 1 - t * t * (3 - 2 * t)  # 1 above the hip, smoothly 0 a ``fall`` below it
+    moving = w > 0
+    floor = np.zeros(int(moving.sum()))
+    if under is not None and len(under):
+        from scipy.spatial import cKDTree
+
+        under_off, _ = skin_offset(body, under.astype(np.float64))
+        reach, nearest = cKDTree(under).query(out[moving])
+        over = (reach < 0.06) & (out[moving, 2] > under[:, 2].min() - 0.01)
+        floor = np.where(over, under_off[nearest] + gap, 0.0)
+    for _ in range(2):  # a second pass corrects the first's error on curved skin
+        off, normal = skin_offset(body, out[moving])
+        target = np.maximum(w[moving] * ease + (1 - w[moving]) * off, floor)
+        out[moving] += (target - off)[:, None] * normal
+    return out
+
+
 def belt_loops(body: AuthoringBody, mesh: Mesh, h: Heights, surface_faces: np.ndarray,
                angles=(25, 80, 140, 180, -140, -80, -25)) -> Piece:  # fmt: skip
     """Belt loops: strips 1.1 cm wide standing 3 mm off the waistband from its top edge to
@@ -467,6 +511,8 @@ __all__ = [
     "layout",
     "leg_axis",
     "panel_coordinates",
+    "sit_on_hips",
+    "skin_offset",
     "skirt_marks",
     "straight_legs",
     "trouser_marks",
