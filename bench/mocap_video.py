@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/mocap_video.py [--clip PATH.bvh] [--frames 240]
         [--wear tshirt --wear jeans] [--strip docs/images/mocap_video.png]
+        [--keep DIR [--reuse]]
 
 A dressed Avatar character performs a fixture clip (travel removed: a camera tracking the
 pelvis), rendered with Blender's Workbench into an MP4 (OpenCV); ``avatar mocap video``
@@ -10,6 +11,8 @@ joints (MPJPE, PA-MPJPE in mm, direction error per bone; ``avatar.mocap.groundtr
 Anchor: HybrIK reports PA-MPJPE 44.5 mm on 3DPW (real videos; a different, harder test).
 Also prints MediaPipe's frames/s on this CPU. With --strip, writes a side-by-side picture
 (top: rendered input; bottom: the solved motion on the same character and camera).
+--keep DIR keeps the video and its camera there; --reuse then skips the render (the clip,
+frame count and clothes must be the same) to re-run the estimate, the solve and the strip.
 """
 
 from __future__ import annotations
@@ -37,7 +40,8 @@ FIXTURE = (
 
 
 def run(clip_path: Path, frames: int, wear: list[str], resolution: tuple[int, int],
-        folder: Path, strip: Path | None, every: int) -> groundtruth.Comparison:  # fmt: skip
+        folder: Path, strip: Path | None, every: int,
+        reuse: bool = False) -> groundtruth.Comparison:  # fmt: skip
     human = avatar.Human()
     if wear:
         human = human.dressed(*wear)
@@ -46,11 +50,18 @@ def run(clip_path: Path, frames: int, wear: list[str], resolution: tuple[int, in
     clip, _ = retarget(source, clip, human.skeleton, measure=False)
     truth = groundtruth.in_place(human.skeleton, clip)
     character = export.character(human, truth, resolve_garments=False)
-    movie = folder / "input.mp4"
-    t = time.perf_counter()
-    pictures, camera = groundtruth.render_video(character, movie, truth.fps, resolution)
-    print(f"rendered {len(pictures)} frames {resolution[0]}x{resolution[1]} (Workbench) in "
-          f"{time.perf_counter() - t:.1f} s -> {movie}")  # fmt: skip
+    movie, saved = folder / "input.mp4", folder / "camera.npy"
+    print(f"clip {clip_path.name}: {truth.frames} frames at {truth.fps:g} fps")
+    if reuse and movie.is_file() and saved.is_file():
+        camera = np.load(saved)
+        pictures = np.array(list(video.frames(movie)[2]))
+        print(f"reusing {movie} ({len(pictures)} frames)")
+    else:
+        t = time.perf_counter()
+        pictures, camera = groundtruth.render_video(character, movie, truth.fps, resolution)
+        np.save(saved, camera)
+        print(f"rendered {len(pictures)} frames {resolution[0]}x{resolution[1]} (Workbench) "
+              f"in {time.perf_counter() - t:.1f} s -> {movie}")  # fmt: skip
     out = folder / "solved.bvh"
     t = time.perf_counter()
     assert cli(["mocap", "video", str(movie), "-o", str(out)]) == 0
@@ -99,12 +110,14 @@ def main() -> None:
     parser.add_argument("--strip", type=Path, default=None)
     parser.add_argument("--every", type=int, default=30, help="strip: every N-th frame")
     parser.add_argument("--keep", type=Path, default=None, help="keep the video here")
+    parser.add_argument("--reuse", action="store_true", help="--keep's video, not rendered again")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     wear = args.wear or ["tshirt", "jeans"]
     if args.keep:
         args.keep.mkdir(parents=True, exist_ok=True)
-        run(Path(args.clip), args.frames, wear, (width, height), args.keep, args.strip, args.every)
+        run(Path(args.clip), args.frames, wear, (width, height), args.keep, args.strip, args.every,
+            args.reuse)  # fmt: skip
         return
     with tempfile.TemporaryDirectory(prefix="avatar-mocap-video-") as tmp:
         run(Path(args.clip), args.frames, wear, (width, height), Path(tmp), args.strip,

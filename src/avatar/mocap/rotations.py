@@ -200,12 +200,12 @@ def kabsch(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]],
     s0, s1, _ = s.tolist()
     if not s1 >= 1e-9 * max(s0, 1e-300):  # (NaN from a non-finite input too)
         return None
-    v = vt.T.ravel().tolist()
-    ut = u.T.ravel().tolist()
-    r = mul(v, ut)
-    if det(r) < 0:  # a reflection: flip the least significant axis
+    (r0, r3, r6), (r1, r4, r7), (r2, r5, r8) = (u @ vt).tolist()  # R = V U^T: its transpose
+    r: M = (r0, r1, r2, r3, r4, r5, r6, r7, r8)
+    if det(r) < 0:  # a reflection: flip the least significant axis (V's last column)
+        v = vt.T.ravel().tolist()
         v[2], v[5], v[8] = -v[2], -v[5], -v[8]
-        r = mul(v, ut)
+        r = mul(v, u.T.ravel().tolist())
     return r
 
 
@@ -238,8 +238,9 @@ def quaternions(r: np.ndarray) -> np.ndarray:
     """(n, 3, 3) or (n, 9) rotations -> (n, 4) unit quaternions (w, x, y, z) with w >= 0
     (``avatar.rig.quaternion.from_matrix``, in a few calls)."""
     n = len(r)
-    cands = (r.reshape(n, 9) @ _QUAT_MAP + _QUAT_ONE).reshape(n, 4, 4)
-    best = np.argmax(cands[:, [0, 1, 2, 3], [0, 1, 2, 3]], axis=1)
-    q = cands[np.arange(n), best]
-    q /= np.sqrt((q * q).sum(1))[:, None]
-    return np.where(q[:, :1] < 0, -q, q)
+    flat = r.reshape(n, 9) @ _QUAT_MAP
+    flat += _QUAT_ONE
+    best = flat[:, ::5].argmax(axis=1)  # the pivots: entries 0, 5, 10, 15 of each 4x4
+    q = flat.reshape(n, 4, 4)[np.arange(n), best]
+    q *= (np.where(q[:, 0] < 0, -1.0, 1.0) / np.sqrt((q * q).sum(1)))[:, None]
+    return q

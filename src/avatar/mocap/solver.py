@@ -132,7 +132,9 @@ class _Chain:
     carrier's head in the first bone's rest frame, for a tip's point its offset in the tip's
     own frame (turned by the tip's latest pose at each pass).
     tips: (step, index in steps of the bone it hangs on, the tip's head from that bone's
-    head in the first bone's rest frame, its rest rotation in the first bone's rest frame).
+    head in the first bone's rest frame, its rest rotation in the first bone's rest frame);
+    tip_on: the second entries. rel: each bone's rest rotation in the previous bone's rest
+    frame (the first's: in its anchor's).
     """
 
     name: str
@@ -148,6 +150,8 @@ class _Chain:
     lever: tuple[rot.V, ...]
     tips: tuple[tuple[int, int, rot.V, rot.M], ...]
     tip_ids: tuple[int, ...]
+    tip_on: tuple[int, ...]
+    rel: tuple[rot.M, ...]
 
 
 def _m(a: np.ndarray) -> rot.M:
@@ -198,6 +202,7 @@ class PoseSolver:
         self._point_ids = np.array([c[0] for c in carried], dtype=int)
         self._point_owner = np.array([c[1] for c in carried], dtype=int)
         self._point_offsets = np.array([c[2] for c in carried]).reshape(-1, 3, 1)
+        self._ones = [1.0] * len(rig.keypoints.names)  # weights when no confidence is given
         self.reset()
 
     def _prepare_bone(self, st) -> _Bone:
@@ -229,7 +234,8 @@ class PoseSolver:
                       tuple(_v(h) for h in hops), tuple(float(x) for x in chain.limit),
                       tuple(int(k) for k in chain.points), tuple(_v(o) for o in chain.offsets),
                       tuple(carrier), tuple(tip), tuple(lever), tuple(tips),
-                      tuple(int(i) for i in chain.tips))  # fmt: skip
+                      tuple(int(i) for i in chain.tips), tuple(t[1] for t in tips),
+                      tuple(self._bone[i].rel for i in ids))  # fmt: skip
 
     def _prepare_schedule(self) -> list[tuple[str, object]]:
         """The plan's schedule with batches as step lists and chains prepared; the spine's
@@ -238,11 +244,13 @@ class PoseSolver:
         for kind, item in self.plan.schedule[1:]:
             if kind == "chain":
                 chain = self._chains[str(item)]
-                out.append(("chain", chain))
                 tips = self.plan.chains[str(item)].tip_batch
                 if item == "spine_chain" and tips is not None:
+                    out.append(("first", chain))
                     out.append(("bones", [int(i) for i in tips.steps]))
-                    out.append(("chain", chain))
+                    out.append(("again", chain))
+                else:
+                    out.append(("once", chain))
             else:
                 out.append(("bones", [int(i) for i in item.steps]))  # type: ignore[attr-defined]
         return out
@@ -272,6 +280,10 @@ class PoseSolver:
         t = (0.0 if self._time is None else self._time + 1 / 30) if t is None else float(t)
         dt = 1 / 30 if self._time is None else max(t - self._time, 1e-6)
         self._time = t
+        if confidence is None and np.isfinite(p).all():  # the usual frame: nothing missing
+            p = self._filter(p, t)
+            ok = np.isfinite(p).all(axis=1).tolist()
+            return self._solve(p.tolist(), ok, self._ones, t, dt)
         finite = np.isfinite(p).all(axis=1)
         if confidence is not None:
             c = np.asarray(confidence, dtype=np.float64).reshape(k)
@@ -289,14 +301,15 @@ class PoseSolver:
     def _solve(self, p: list, ok: list, w: list, t: float, dt: float) -> SolvedFrame:
         n = self._count
         decay = math.exp(-dt / self.settings.hold) if self.settings.hold > 0 else 0.0
-        f = _Frame(p, ok, w, [rot.EYE] * n, [rot.ZERO] * n, [rot.EYE] * n, [False] * n, decay)
+        f = _Frame(p, ok, w, [rot.EYE] * n, [rot.ZERO] * n, [rot.EYE] * n, [False] * n, decay,
+                   {})  # fmt: skip
         self._solve_root(f)
         for kind, item in self._schedule:
-            if kind == "chain":
-                self._solve_chain(f, item)  # type: ignore[arg-type]
-            else:
+            if kind == "bones":
                 for i in item:  # type: ignore[attr-defined]
                     self._solve_bone(f, i)
+            else:
+                self._solve_chain(f, item, kind)  # type: ignore[arg-type]
         contacts = np.zeros(2, dtype=bool)
         if self.settings.plant_feet:
             contacts = self._feet(f, dt, self._inherit)
@@ -398,34 +411,56 @@ class PoseSolver:
 
     # -- chains (spine, neck) --------------------------------------------------------------
 
-    def _solve_chain(self, f: _Frame, c: _Chain) -> None:
+    def _solve_chain(self, f: _Frame, c: _Chain, mode: str = "once") -> None:
         """One turn shared along the chain (bone k of n takes (k+1)/n of it), fitted to the
-        chain's keypoints, then refined twice for the points the shared bend moves."""
-        base0, head0 = self._inherit(f, c.steps[0])
-        keep = [j for j, k in enumerate(c.points) if f.ok[k]]
-        b = [rot.sub(f.p[c.points[j]], head0) for j in keep]
-        wt = [f.w[c.points[j]] for j in keep]
-        a = [rot.apply(base0, c.offsets[j]) for j in keep]
-        turn = rot.kabsch(a, b, wt) if len(b) >= 2 else None
-        if turn is None and len(b) >= 1:
-            turn = rot.arc(rot.weighted_sum(a, wt), rot.weighted_sum(b, wt))
+        chain's keypoints, then refined twice for the points the shared bend moves.
+
+        mode: "once"; "first" (the spine before its tips, the clavicles, are solved: only
+        what they hang on is placed, and the initial fit is kept in the frame) and "again"
+        (after them: the kept fit, the same inputs, reused)."""
+        fit = f.fits.pop(c.name, None) if mode == "again" else None
+        if fit is None:
+            fit = self._chain_fit(f, c)
+            if mode == "first":
+                f.fits[c.name] = fit
+        base0, head0, keep, b, wt, turn, hops = fit
         if turn is None:
             for i in c.steps:
                 base, f.heads[i] = self._inherit(f, i)
                 self._finish(f, i, base, None)
             return
         levers, fixed = self._chain_levers(f, c, base0, keep)
-        hops = [rot.apply(base0, h) for h in c.hops]
+        two = len(b) >= 2
         for _ in range(2):  # the shared bend moves the points: fit the residual turn
             axis, angle = rot.log(turn)
             got = self._chain_points(c, keep, axis, angle, hops, levers, fixed)
-            fix = (rot.kabsch(got, b, wt) if len(b) >= 2
+            fix = (rot.kabsch(got, b, wt) if two
                    else rot.arc(rot.weighted_sum(got, wt), rot.weighted_sum(b, wt)))  # fmt: skip
             if fix is None or rot.angle(fix) < 1e-5:
                 break
             turn = rot.mul(fix, turn)
         axis, angle = rot.log(turn)
-        self._place_chain(f, c, base0, head0, axis, angle)
+        if mode == "first":
+            self._place_tips_anchor(f, c, base0, head0, axis, angle, hops)
+        else:
+            self._place_chain(f, c, base0, head0, axis, angle, hops)
+
+    def _chain_fit(self, f: _Frame, c: _Chain) -> tuple:
+        """The chain's inputs and initial turn: (its base rotation and head, kept points,
+        their positions from the head and weights, the turn (None: nothing seen), the hops
+        between its heads in world axes at rest)."""
+        base0, head0 = self._inherit(f, c.steps[0])
+        p, ok, w, points = f.p, f.ok, f.w, c.points
+        keep = [j for j, k in enumerate(points) if ok[k]]
+        hx, hy, hz = head0
+        b = [(p[points[j]][0] - hx, p[points[j]][1] - hy, p[points[j]][2] - hz) for j in keep]
+        wt = [w[points[j]] for j in keep]
+        a = [rot.apply(base0, c.offsets[j]) for j in keep]
+        turn = rot.kabsch(a, b, wt) if len(b) >= 2 else None
+        if turn is None and len(b) >= 1:
+            turn = rot.arc(rot.weighted_sum(a, wt), rot.weighted_sum(b, wt))
+        hops = [rot.apply(base0, h) for h in c.hops] if turn is not None else []
+        return base0, head0, keep, b, wt, turn, hops
 
     def _chain_levers(self, f: _Frame, c: _Chain, base0: rot.M, keep: list[int]):
         """Per kept point, the vector its carrier's turn moves (world axes, at rest) and a
@@ -472,34 +507,68 @@ class PoseSolver:
         return out
 
     def _place_chain(self, f: _Frame, c: _Chain, base0: rot.M, head0: rot.V, axis: rot.V,
-                     angle: float) -> None:  # fmt: skip
+                     angle: float, hops: list[rot.V]) -> None:  # fmt: skip
         """Pose the chain's bones: bone k of n turned by angle * (k+1)/n about ``axis`` from
         its rest pose on the chain's base; bone by bone (``_finish``) where a joint limit
         bites. Relative to the bone before, each is turned by angle / n about that axis as
         its own rest frame sees it (rest frames are rigid), which gives its local rotation
-        without a product of the posed frames."""
+        without a product of the posed frames; heads are the hops turned (Rodrigues)."""
         n = len(c.steps)
-        world, local, heads = [], [], [head0]
-        bites = False
-        for k in range(n):
-            at_rest = rot.mul(base0, c.rest_rel[k])
-            world.append(rot.mul(rot.turn(axis, angle * ((k + 1) / n)), at_rest))
-            own = rot.turn(rot.tapply(at_rest, axis), angle * ((k + 1) / n) - angle * (k / n))
-            local.append(own)
-            bites = bites or (self.settings.limits and rot.angle(own) > c.limits[k])
-            if k:
-                step = self._bone[c.steps[k]].step
-                heads.append(rot.add(heads[-1], rot.apply(world[k - 1], step)))
-        if bites:
+        if self._chain_bites(c, angle):
             for k, i in enumerate(c.steps):
+                at_rest = rot.mul(base0, c.rest_rel[k])
+                world_k = rot.mul(rot.turn(axis, angle * ((k + 1) / n)), at_rest)
                 base_k, f.heads[i] = self._inherit(f, i)
-                self._finish(f, i, base_k, rot.tmul(base_k, world[k]))
+                self._finish(f, i, base_k, rot.tmul(base_k, world_k))
             return
+        ax0 = rot.tapply(base0, axis)  # the axis in the first bone's rest frame
+        step = angle / n
+        s, co = math.sin(step), math.cos(step)
+        t = 1.0 - co
+        world, head = base0, head0
         for k, i in enumerate(c.steps):
-            f.heads[i] = heads[k]
-            self._last[i] = f.local[i] = local[k]
+            x, y, z = rot.tapply(c.rest_rel[k], ax0)  # the axis in bone k's rest frame
+            own = (co + t * x * x, t * x * y - s * z, t * x * z + s * y,
+                   t * x * y + s * z, co + t * y * y, t * y * z - s * x,
+                   t * x * z - s * y, t * y * z + s * x, co + t * z * z)  # fmt: skip
+            if k:
+                a_k = angle * (k / n)
+                hx, hy, hz = rot.rotate(axis, math.cos(a_k), math.sin(a_k), hops[k])
+                head = (head[0] + hx, head[1] + hy, head[2] + hz)
+                world = rot.mul(world, c.rel[k])
+            world = rot.mul(world, own)
+            f.heads[i] = head
+            self._last[i] = f.local[i] = own
             f.solved[i] = True
-            f.world[i] = world[k]
+            f.world[i] = world
+
+    def _place_tips_anchor(self, f: _Frame, c: _Chain, base0: rot.M, head0: rot.V,
+                           axis: rot.V, angle: float, hops: list[rot.V]) -> None:  # fmt: skip
+        """The first of two passes (``_solve_chain`` "first"): place only the chain bones
+        its tips hang on (what the tips' solve reads), unless a limit bites."""
+        if self._chain_bites(c, angle):
+            self._place_chain(f, c, base0, head0, axis, angle, hops)
+            return
+        n = len(c.steps)
+        head = head0
+        for k in range(1, max(c.tip_on) + 1):
+            a_k = angle * (k / n)
+            hx, hy, hz = rot.rotate(axis, math.cos(a_k), math.sin(a_k), hops[k])
+            head = (head[0] + hx, head[1] + hy, head[2] + hz)
+            if k in c.tip_on:
+                f.heads[c.steps[k]] = head
+        for k in set(c.tip_on):
+            at_rest = rot.mul(base0, c.rest_rel[k])
+            f.world[c.steps[k]] = rot.mul(rot.turn(axis, angle * ((k + 1) / n)), at_rest)
+        if 0 in c.tip_on:
+            f.heads[c.steps[0]] = head0
+
+    def _chain_bites(self, c: _Chain, angle: float) -> bool:
+        """Whether a joint limit stops a chain bone's share of ``angle`` (radians, >= 0)."""
+        if not self.settings.limits:
+            return False
+        n = len(c.steps)
+        return any(angle * ((k + 1) / n) - angle * (k / n) > c.limits[k] for k in range(n))
 
     def _rigid(self, f: _Frame, i: int) -> rot.M | None:
         """World rotation of bone i from a rigid fit (rotation and translation) of its own
@@ -528,6 +597,20 @@ class PoseSolver:
         base = rot.mul(wa, b.rel)
         head = f.heads[i] = rot.add(f.heads[b.anchor], rot.apply(wa, b.step))
         ok, p = f.ok, f.p
+        if len(b.points) == 1:  # most bones: one keypoint, a swing (written out: hot path)
+            k = b.points[0]
+            if not ok[k]:
+                self._finish(f, i, base, None)
+                return
+            origin = p[b.origin] if b.origin >= 0 and ok[b.origin] else head
+            wk, q = f.w[k], p[k]
+            along = ((q[0] - origin[0]) * wk, (q[1] - origin[1]) * wk, (q[2] - origin[2]) * wk)
+            o = b.offsets[0]
+            swing = _arc_in(base, (o[0] * wk, o[1] * wk, o[2] * wk), along)
+            if b.pole is not None:
+                swing = self._twist(f, b, base, swing, along)
+            self._finish(f, i, base, swing)
+            return
         keep = [r for r, k in enumerate(b.points) if ok[k]]
         if not keep:
             self._finish(f, i, base, None)
@@ -576,13 +659,15 @@ class PoseSolver:
     # -- output ----------------------------------------------------------------------------
 
     def _output(self, f: _Frame, t: float, contacts: np.ndarray) -> SolvedFrame:
+        n = self._count
+        frames = np.array(f.local + f.world)  # (2S, 9): one conversion for both
         rotations = self._identity.copy()
-        rotations[self._bones] = rot.quaternions(np.array(f.local))
+        rotations[self._bones] = rot.quaternions(frames[:n])
         translations = np.zeros((len(self._identity), 3))
         translations[self._hips] = rot.tapply(self._hips_rest, rot.sub(f.heads[0], self._hips_head))
         points = np.full((len(self.rig.keypoints.names), 3), np.nan)
         own = self._point_owner
-        world = np.array(f.world).reshape(-1, 3, 3)[own]
+        world = frames[n:].reshape(-1, 3, 3)[own]
         points[self._point_ids] = np.array(f.heads)[own] + (world @ self._point_offsets)[:, :, 0]
         return SolvedFrame(rotations, translations, points, t, np.array(f.solved), contacts)
 
@@ -601,9 +686,13 @@ def _arc_in(base: rot.M, rest: rot.V, along: rot.V) -> rot.M:
     zero the arc is the identity or a half turn whose axis depends on the frame: that rare
     case is computed in world axes, as before, and brought into the frame."""
     mine = rot.tapply(base, along)
-    c = rot.cross(rot.unit(rest), rot.unit(mine))
-    if rot.dot(c, c) >= 1e-17:
-        return rot.arc(rest, mine)
+    ax, ay, az = rot.unit(rest)
+    bx, by, bz = rot.unit(mine)
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    s2 = cx * cx + cy * cy + cz * cz
+    if s2 >= 1e-17:  # ``rot.arc(rest, mine)``, written out (s > 1e-9: its general case)
+        s = math.sqrt(s2)
+        return rot.turn((cx / s, cy / s, cz / s), math.atan2(s, ax * bx + ay * by + az * bz))
     world = rot.arc(rot.apply(base, rest), along)
     return rot.tmul(base, rot.mul(world, base))
 
@@ -622,6 +711,7 @@ class _Frame:
     local: list
     solved: list
     decay: float
+    fits: dict  # chain name -> its initial fit, kept between the spine's two passes
 
 
 def solve(rig: RigKeypoints, points: np.ndarray, confidence: np.ndarray | None = None,
