@@ -104,3 +104,91 @@ def test_dress_skirt_stays_on_the_hips_mid_stride():
         top = rest_skirt[:, 2] > hip_z  # the rows that sit on the hips at rest
         off = _signed(human, body[:13380], skirt[top])
         assert np.median(off) < 0.02 and np.percentile(off, 90) < 0.032, params
+
+
+# ---------------------------------------------------------------------------- denim
+
+
+def _linear_luminance(texture: np.ndarray) -> np.ndarray:
+    c = texture[..., :3].astype(np.float64) / 255
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) @ [0.2126, 0.7152,
+                                                                               0.0722]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def jeans():
+    from dataclasses import replace
+
+    spec = builtin.BY_NAME["jeans"]
+    piece = spec.make(library.authoring_body())
+    material = builtin.look(spec, piece.layout, 512)
+    light = builtin.look(replace(spec, colour="light indigo"), piece.layout, 512)
+    return piece, material, light
+
+
+def test_jeans_are_dark_indigo_with_a_light_wash_variant(jeans):
+    """Real indigo denim is dark: the default jeans' colour map has a median linear
+    luminance under 0.065 (it was 0.096, a light even blue); the light-wash variant is
+    more than three times lighter, and the dye is blue (blue channel the strongest)."""
+    _, material, light = jeans
+    lum = _linear_luminance(material.base_color_texture)
+    assert np.median(lum) < 0.065
+    assert np.median(_linear_luminance(light.base_color_texture)) > 3 * np.median(lum)
+    mean_rgb = material.base_color_texture[..., :3].reshape(-1, 3).mean(axis=0)
+    assert mean_rgb[2] > 1.3 * mean_rgb[0]
+
+
+def test_jeans_fade_at_thighs_knees_seams_and_whiskers(jeans):
+    """Worn denim is lighter where it rubs: the thigh and knee fades (the widest washes),
+    along the seams and over the whiskers at the hips, against the unworn cloth."""
+    from avatar.looks.tailored import Canvas
+
+    piece, material, _ = jeans
+    lum = _linear_luminance(material.base_color_texture)
+    size = lum.shape[0]
+    canvas = Canvas(size)
+    washes = [m for m in piece.layout.marks if m.kind == "wash"]
+    unworn = float(np.median(lum))
+    for mark in sorted(washes, key=lambda m: -m.width)[:4]:  # thighs and knees, both legs
+        x, y = canvas.to_pixels(mark.points)[0].astype(int)
+        assert lum[y - 3 : y + 4, x - 3 : x + 4].mean() > 1.4 * unworn
+    seams = next(m for m in piece.layout.marks if m.kind == "seam" and m.points.ndim == 3)
+    d, _, window = canvas.distance(seams.points, 12)
+    near, far = lum[window][d < 2.5], lum[window][(d > 8) & (d < 12)]
+    assert near.mean() > 1.12 * np.median(far)
+    whiskers = [m for m in washes if abs(m.width - 0.006) < 1e-9]
+    assert len(whiskers) >= 8
+    d, _, window = canvas.distance(whiskers[0].points, 10)
+    assert lum[window][d < 1.5].mean() > 1.25 * unworn
+
+
+def test_denim_twill_runs_diagonally_in_the_normal_and_roughness_maps(jeans):
+    """A twill's wales run on the diagonal: the roughness and normal maps change much less
+    along one diagonal than across it (a plain weave or noise would not), and the weave's
+    relief is strong enough to catch light (normals tilt by several degrees)."""
+    _, material, _ = jeans
+    size = material.roughness_texture.shape[0]
+    s = size // 2
+    for texture in (material.roughness_texture.astype(float),
+                    material.normal_texture[..., 0].astype(float)):  # fmt: skip
+        patch = texture[s - 64 : s + 64, s - 64 : s + 64]
+        along = np.abs(patch[1:, 1:] - patch[:-1, :-1]).mean()
+        across = np.abs(patch[1:, :-1] - patch[:-1, 1:]).mean()
+        assert max(along, across) > 1.6 * min(along, across), (along, across)
+    tilt = np.abs(material.normal_texture[..., :2].astype(float) - 128).mean() / 128
+    assert tilt > 0.05
+    assert np.ptp(np.percentile(material.roughness_texture, [5, 95])) > 25  # not flat
+
+
+def test_anything_denim_gets_the_yarn_dyed_look():
+    """A denim variant of another garment (a cap, a skirt) is dark indigo with light weft
+    in the twill and warp slubs streaking it lengthwise: columns differ more than rows."""
+    from avatar.looks import fabrics
+
+    tex = fabrics.colour_map("denim", "indigo", 256)
+    lum = _linear_luminance(tex)
+    assert np.median(lum) < 0.065
+    cols, rows = lum.mean(axis=0), lum.mean(axis=1)
+    assert cols.std() > 1.5 * rows.std()
+    plain = fabrics.colour_map("cotton", "indigo", 256)
+    assert np.percentile(lum, 99) > 1.5 * np.percentile(_linear_luminance(plain), 99)

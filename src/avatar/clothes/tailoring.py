@@ -201,8 +201,11 @@ def _double(panels: Panels, k: int, u: np.ndarray, z: np.ndarray, du: float = 0.
 def jeans_marks(panels: Panels, h: Heights) -> list[Mark]:
     """Five-pocket jeans: waistband, front scoop pockets with rivets, a coin pocket, the fly's
     J-stitch, back yoke and patch pockets, felled inseams, hems; whiskers, worn knees and
-    seat, folds behind the knees and stacked at the hems."""
+    seat, faded seams, waistband and hem edges (where wear rubs the dye off first), folds
+    behind the knees and stacked at the hems."""
     marks = panels.seams()
+    # Seam ridges wear first: a light line along every seam, broken by the blotches.
+    marks += [Mark("wash", m.points, 0.0035, 0.45) for m in marks if m.kind == "seam"]
     for k, panel in enumerate(panels.panels):
         def inner(z, k=k):
             return panels.edge(k, np.atleast_1d(z), False)
@@ -214,7 +217,9 @@ def jeans_marks(panels: Panels, h: Heights) -> list[Mark]:
                   Mark("stitch", _across(panels, k, h.top - 0.005), 0.0007),
                   Mark("stitch", _across(panels, k, h.band + 0.004), 0.0007),
                   Mark("edge", _across(panels, k, h.hem + 0.024)),
-                  Mark("stitch", _across(panels, k, h.hem + 0.016), 0.0008)]  # fmt: skip
+                  Mark("stitch", _across(panels, k, h.hem + 0.016), 0.0008),
+                  Mark("wash", _across(panels, k, h.top - 0.002), 0.004, 0.5),
+                  Mark("wash", _across(panels, k, h.hem + 0.024), 0.004, 0.5)]  # fmt: skip
         # Felled inseam and rise: double stitches beside the inner edge.
         z = np.linspace(h.hem + 0.03, h.band - 0.003, 60)
         marks += _double(panels, k, inner(z), z, du=0.006)
@@ -256,11 +261,11 @@ def jeans_marks(panels: Panels, h: Heights) -> list[Mark]:
                                   h.crotch + 0.025 + 0.018 * j])
                 end = start + [0.09 + 0.015 * j, 0.035 + 0.01 * j]
                 line = panels.uv(k, np.linspace(start, end, 8))
-                marks += [Mark("fold", line, 0.0035, 0.7), Mark("wash", line, 0.006, 0.35)]
+                marks += [Mark("fold", line, 0.0035, 0.7), Mark("wash", line, 0.006, 0.6)]
             thigh = (h.crotch + h.knee) / 2
             marks += [Mark("wash", _line(panels, k, mid(h.knee + 0.03), np.array([h.knee + 0.03])),
-                           0.09, 0.55),
-                      Mark("wash", _line(panels, k, mid(thigh), np.array([thigh])), 0.1, 0.35)]
+                           0.09, 0.6),
+                      Mark("wash", _line(panels, k, mid(thigh), np.array([thigh])), 0.11, 0.5)]
         else:
             uy = np.linspace(inner(h.band - 0.07)[0], outer(h.band - 0.03)[0], 20)
             zy = np.linspace(h.band - 0.07, h.band - 0.03, 20)

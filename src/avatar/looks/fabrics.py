@@ -29,11 +29,20 @@ class Fabric:
     depth: float  # normal strength
     roughness: float
     contrast: float  # colour variation driven by the height field
+    # Yarn-dyed twill (denim): the colour is the warp's; the undyed weft (linear RGB) shows
+    # in the twill's valleys, up to ``weft_share`` of a texel, and the warp's ring-spun
+    # slubs streak the cloth along its length by +-``slub``.
+    weft: tuple[float, float, float] | None = None
+    weft_share: float = 0.0
+    slub: float = 0.0
+    relief: float = 0.12  # mm: the weave's height on a tailored garment's normal map
+    rough_weave: float = 0.06  # roughness change over the weave (fibre ridges vs valleys)
 
 
 FABRICS = {
     "cotton": Fabric("cotton", "plain", 180, 1.2, 0.85, 0.12),
-    "denim": Fabric("denim", "twill", 120, 2.0, 0.8, 0.35),
+    "denim": Fabric("denim", "twill", 120, 2.0, 0.8, 0.2, weft=(0.42, 0.4, 0.34),
+                    weft_share=0.3, slub=0.18, relief=0.3, rough_weave=0.16),
     "knit": Fabric("knit", "knit", 36, 2.5, 0.9, 0.25),
     "jersey": Fabric("jersey", "knit", 90, 1.2, 0.8, 0.1),
     "leather": Fabric("leather", "grain", 40, 1.5, 0.45, 0.15),
@@ -49,7 +58,9 @@ FABRICS = {
 
 COLOURS = {
     "white": (0.85, 0.85, 0.83), "black": (0.03, 0.03, 0.035), "grey": (0.35, 0.36, 0.38),
-    "navy": (0.03, 0.06, 0.18), "indigo": (0.05, 0.09, 0.25), "red": (0.55, 0.05, 0.05),
+    # Indigo: a denim's warp as worn (mid-dark, before the weft shows through); light
+    # indigo a light wash, dark indigo a rinse.
+    "navy": (0.03, 0.06, 0.18), "indigo": (0.014, 0.024, 0.085), "red": (0.55, 0.05, 0.05),
     "green": (0.08, 0.25, 0.1), "olive": (0.2, 0.22, 0.08), "khaki": (0.45, 0.38, 0.22),
     "brown": (0.18, 0.09, 0.04), "beige": (0.62, 0.52, 0.4), "sky": (0.3, 0.5, 0.75),
     "yellow": (0.8, 0.6, 0.08), "pink": (0.75, 0.35, 0.45), "teal": (0.04, 0.3, 0.32),
@@ -58,7 +69,7 @@ COLOURS = {
     "charcoal": (0.06, 0.06, 0.065), "burgundy": (0.22, 0.02, 0.04),
     "auburn hair": (0.14, 0.045, 0.018), "grey hair": (0.36, 0.35, 0.34),
     "dark brown": (0.07, 0.035, 0.018), "light indigo": (0.16, 0.25, 0.45),
-    "dark indigo": (0.02, 0.035, 0.11), "light grey": (0.6, 0.61, 0.62),
+    "dark indigo": (0.007, 0.011, 0.04), "light grey": (0.6, 0.61, 0.62),
 }  # fmt: skip
 
 
@@ -150,16 +161,40 @@ def maps(fabric_name: str, size: int = 1024, seed: int = 0):
     """(height (S, S) float32, normal (S, S, 3) uint8, roughness (S, S) uint8), cached."""
     fabric = FABRICS[fabric_name]
     h = height_field(fabric, size, seed)
-    rough = np.clip(fabric.roughness + 0.08 * h, 0, 1)
+    rough = np.clip(fabric.roughness + max(0.08, fabric.rough_weave) * h, 0, 1)
     return h, normal_map(h, fabric.depth * size / 256), np.round(rough * 255).astype(np.uint8)
+
+
+def streaks(size: int, rng: np.random.Generator, length: int) -> np.ndarray:
+    """(size, size) float32 tileable streaks in about [-1, 1] running down the columns
+    (along v: a warp's length): noise averaged over ``length`` rows (wrapped)."""
+    n = _noise(size, rng, 8, max(9, size // 6))
+    total = np.cumsum(np.concatenate([n, n[:length]]), axis=0)
+    out = (total[length:] - total[:-length]) / length
+    return (out / max(float(np.abs(out).max()), 1e-6)).astype(np.float32)
+
+
+def yarn_colour(fabric: Fabric, colour: np.ndarray, height: np.ndarray,
+                slubs: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """(H, W, 3) float32 linear colour of a fabric in ``colour`` (3,) over its weave's
+    ``height`` (H, W): shaded by the height field; for a yarn-dyed twill (``weft``) the
+    warp's colour streaked by ``slubs`` (H, W) with the light weft in the valleys."""
+    shade = 1.0 + fabric.contrast * height
+    out = colour[None, None, :].astype(np.float32) * shade[..., None]
+    if fabric.weft is None:
+        return out
+    if slubs is not None:
+        out = out * (1.0 + fabric.slub * slubs)[..., None]
+    weft = fabric.weft_share * np.clip((0.15 - height) / 0.9, 0, 1)
+    return out * (1 - weft[..., None]) + np.asarray(fabric.weft, np.float32) * weft[..., None]
 
 
 def colour_map(fabric_name: str, colour, size: int = 1024, seed: int = 0) -> np.ndarray:
     """(S, S, 3) uint8 sRGB colour texture of a fabric in a linear RGB colour (or a name)."""
-    linear = rgb(colour)
+    fabric = FABRICS[fabric_name]
     h, _, _ = maps(fabric_name, size, seed)
-    shade = 1.0 + FABRICS[fabric_name].contrast * h
-    return srgb(linear[None, None, :] * shade[..., None])
+    slubs = streaks(size, np.random.default_rng([seed, size, 11]), max(4, size // 8))
+    return srgb(yarn_colour(fabric, rgb(colour), h, slubs if fabric.slub else None))
 
 
 def material(

@@ -156,8 +156,11 @@ def material(name: str, fabric_name: str, colour, layout: Layout, size: int = 20
     canvas = Canvas(size)
     px_mm = layout.scale * size / 1000  # pixels per millimetre of cloth
     base = weave(fabric, size, layout.scale * size)
-    height = (0.12 * base).astype(np.float32)  # mm: the weave's relief
+    height = (fabric.relief * base).astype(np.float32)  # mm: the weave's relief
     shade = (1.0 + fabric.contrast * base).astype(np.float32)
+    # Warp slubs streak the cloth along its length (the panels' v runs down the leg).
+    slub_tile = fabrics.streaks(256, np.random.default_rng([size, 11]), 40)
+    slubs = np.tile(slub_tile, (size // 256 + 1, size // 256 + 1))[:size, :size]
     thread = np.zeros((size, size), np.float32)  # stitch coverage
     metal = np.zeros((size, size), np.float32)
     wash = np.zeros((size, size), np.float32)
@@ -208,8 +211,11 @@ def material(name: str, fabric_name: str, colour, layout: Layout, size: int = 20
     grain = np.kron(fabrics._noise(size // 8, np.random.default_rng([size, 7]), 1, 8),
                     np.ones((8, 8), np.float32))  # blotches, cheap at 2K  # fmt: skip
     wash = np.clip(wash * (0.8 + 0.4 * grain), 0, 1)
-    rgb = _colour(colour).astype(np.float32)[None, None, :] * shade[..., None]
-    faded = rgb + wash[..., None] * (0.55 * np.array([0.45, 0.55, 0.75]) - rgb) * (
+    rgb = fabrics.yarn_colour(fabric, _colour(colour), base, slubs) * (
+        shade / (1.0 + fabric.contrast * base))[..., None]  # marks' shading  # fmt: skip
+    # Worn dye fades towards the undyed yarn, most on the weave's raised threads.
+    worn = np.asarray(fabric.weft if fabric.weft is not None else (0.25, 0.3, 0.41), np.float32)
+    faded = rgb + wash[..., None] * (0.9 * worn * np.array([0.62, 0.78, 1.15]) - rgb) * (
         0.7 + 0.3 * base[..., None])  # fmt: skip
     thread_rgb = _colour(layout.thread).astype(np.float32)
     rgb = faded * (1 - thread[..., None]) + thread_rgb * (0.85 + 0.15 * base[..., None]) * thread[
@@ -218,7 +224,8 @@ def material(name: str, fabric_name: str, colour, layout: Layout, size: int = 20
         0.6 + 0.4 * np.clip(height, 0, 1)[..., None])  # fmt: skip
     # mm of relief -> the normal map's slope: one pixel is 1 / px_mm mm.
     normal = fabrics.normal_map(height.astype(np.float32), px_mm * 1.0)
-    rough = np.clip(fabric.roughness + 0.06 * base - 0.5 * metal + 0.05 * thread, 0.15, 1)
+    rough = np.clip(fabric.roughness + fabric.rough_weave * base - 0.5 * metal + 0.05 * thread
+                    + 0.05 * wash, 0.15, 1)  # fmt: skip
     return Material(
         name=name,
         base_color_texture=fabrics.srgb(rgb),
