@@ -192,3 +192,33 @@ def test_anything_denim_gets_the_yarn_dyed_look():
     assert cols.std() > 1.5 * rows.std()
     plain = fabrics.colour_map("cotton", "indigo", 256)
     assert np.percentile(lum, 99) > 1.5 * np.percentile(_linear_luminance(plain), 99)
+
+
+# ---------------------------------------------------------------------------- cap
+
+
+@pytest.mark.parametrize("params", [{"gender": 1.0}, {"gender": 0.0, "age": 0.12},
+                                    {"gender": 0.0, "weight": 1.0, "age": 0.9}])  # fmt: skip
+def test_cap_sits_on_the_head_at_the_back_and_snug_at_the_brow(params):
+    """On a bare head the cap's rim lies on the skull all round: its back edge at the
+    ear-top line, under the occipital bulge (not perched above it), within 8.5 mm of the
+    skin (9-11 mm before, with a hull bridging the nape), the brow band within 8 mm."""
+    from avatar.clothes import headwear
+
+    human = Human(params).dressed("cap")
+    cap = human.outfit.garments[0].mesh.vertices
+    rim = cap[: headwear.MERIDIANS].astype(np.float64)  # the crown's first ring
+    marks_body = AuthoringBody(human.body)
+    _, eye_z, _ = headwear._frame(marks_body)
+    head = human.vertices[:13380][marks_body.part[:13380] == "head"]
+    wide = np.abs(head[:, 0]) > 0.92 * np.abs(head[:, 0]).max()
+    ear_top = head[wide, 2].max()
+    occiput = head[head[:, 1] > head[:, 1].max() - 0.01, 2].mean()  # the backmost bulge
+    phi = np.degrees(np.arctan2(rim[:, 0], -(rim[:, 1] - cap[:, 1].mean())))
+    back, front = np.abs(phi) > 150, np.abs(phi) < 20
+    assert ear_top - 0.025 < rim[back, 2].mean() < min(ear_top, occiput) + 0.002, (
+        rim[back, 2].mean() - eye_z, ear_top - eye_z, occiput - eye_z)
+    gap = _signed(human, human.vertices[:13380], rim)
+    assert gap.min() > 0.002
+    assert gap[back].mean() < 0.0085 and gap[front].mean() < 0.008, (gap[back].mean(),
+                                                                      gap[front].mean())

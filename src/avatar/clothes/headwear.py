@@ -23,7 +23,7 @@ from avatar.clothes.authoring import AuthoringBody, Piece, banded, bound, join
 from avatar.looks.tailored import Layout, Mark
 from avatar.mesh import Mesh
 
-EASE = 0.009  # m between scalp and crown (room for short hair)
+EASE = 0.007  # m between scalp and crown: a snug sweatband (hair is fitted under it)
 GORES = 6
 MERIDIANS = 72  # around the crown (a multiple of GORES: seams fall on meridians)
 RINGS = 16  # from the rim up to the button
@@ -44,10 +44,12 @@ def _frame(body: AuthoringBody) -> tuple[np.ndarray, float, np.ndarray]:
 
 def rim_height(phi: np.ndarray, eye_z: float) -> np.ndarray:
     """(N,) z of the crown's rim at angles ``phi`` (radians, 0 the front, + the left):
-    above the brows in front, over the ears, lower at the back of the head."""
+    above the brows in front, over the ears' tops, and at the back down to the ear-top
+    line under the occipital bulge (a cap is held by the back of the skull, not perched
+    on its crown)."""
     facing = np.cos(phi)
-    return eye_z + 0.042 * np.maximum(facing, 0) + 0.036 * (1 - np.abs(facing)) \
-        + 0.0 * np.maximum(-facing, 0)
+    return eye_z + 0.042 * np.maximum(facing, 0) + 0.034 * (1 - np.abs(facing)) \
+        - 0.006 * np.maximum(-facing, 0) ** 2
 
 
 def _direction(phi: np.ndarray, z: np.ndarray, centre: np.ndarray, radius: float):
@@ -57,16 +59,17 @@ def _direction(phi: np.ndarray, z: np.ndarray, centre: np.ndarray, radius: float
     return np.stack([flat * np.sin(phi), -flat * np.cos(phi), up], -1)
 
 
-def _scalp_distance(directions: np.ndarray, centre: np.ndarray, head: np.ndarray) -> np.ndarray:
+def _scalp_distance(directions: np.ndarray, centre: np.ndarray, head: np.ndarray,
+                    cone: float = 12.0) -> np.ndarray:  # fmt: skip
     """(N,) how far the scalp reaches from ``centre`` along each direction: the farthest
-    head point within 12 degrees of it, projected on it (a smooth, hull-like reach)."""
+    head point within ``cone`` degrees of it, projected on it (a smooth, hull-like reach)."""
     rel = head - centre
     dist = np.linalg.norm(rel, axis=1)
     unit = rel / dist[:, None]
     out = np.empty(len(directions))
     for i, d in enumerate(directions):
         cos = unit @ d
-        near = cos > np.cos(np.radians(12))
+        near = cos > np.cos(np.radians(cone))
         out[i] = float((dist[near] * cos[near]).max()) if near.any() else float(dist.max())
     return out
 
@@ -85,6 +88,11 @@ def crown(body: AuthoringBody) -> tuple[Mesh, np.ndarray]:
     flat = np.cos(elev)
     dirs = np.stack([flat * np.sin(phi)[None], -flat * np.cos(phi)[None], np.sin(elev)], -1)
     reach = _scalp_distance(dirs.reshape(-1, 3), centre, head).reshape(RINGS, MERIDIANS)
+    # The lowest rings follow the skull under the occipital bulge and over the temples
+    # (a narrow cone, no hull bridging the nape): the band sits on the head all round.
+    low = 3
+    reach[:low] = _scalp_distance(dirs[:low].reshape(-1, 3), centre, head, 5.0).reshape(
+        low, MERIDIANS)  # fmt: skip
     for _ in range(6):  # a structured crown: smooth the reach around and up
         reach = 0.5 * reach + 0.25 * (np.roll(reach, 1, 1) + np.roll(reach, -1, 1))
         reach[1:-1] = 0.5 * reach[1:-1] + 0.25 * (reach[:-2] + reach[2:])
