@@ -14,13 +14,13 @@ import logging
 import os
 from functools import lru_cache
 
-import bpy.utils.previews
+from . import thumbnails
 
 log = logging.getLogger(__name__)
 
 THUMB_SIZE = 96
 THUMB_VERSION = 1  # bump when the picture changes: cached files are keyed by it
-_PREVIEWS = {"collection": None}
+_POSES = thumbnails.Previews()  # the pose library's icons
 
 
 @lru_cache(maxsize=4)
@@ -66,16 +66,8 @@ def roles(root) -> dict[str, str]:
 # ------------------------------------------------------------------ pose thumbnails
 
 
-def previews():
-    if _PREVIEWS["collection"] is None:
-        _PREVIEWS["collection"] = bpy.utils.previews.new()
-    return _PREVIEWS["collection"]
-
-
-def release() -> None:
-    if _PREVIEWS["collection"] is not None:
-        bpy.utils.previews.remove(_PREVIEWS["collection"])
-        _PREVIEWS["collection"] = None
+previews = _POSES.get
+release = _POSES.release
 
 
 def pose_icon(name: str, path: str) -> int:

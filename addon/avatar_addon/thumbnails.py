@@ -12,24 +12,34 @@ import bpy.utils.previews
 log = logging.getLogger(__name__)
 
 SIZE = 96
-_PREVIEWS = {"collection": None}
 
 
-def collection():
-    if _PREVIEWS["collection"] is None:
-        _PREVIEWS["collection"] = bpy.utils.previews.new()
-    return _PREVIEWS["collection"]
+class Previews:
+    """One feature's ``bpy.utils.previews`` collection: made on first use, released at
+    unregister (Blender warns about collections left open), so each panel's icons live and
+    die together."""
+
+    def __init__(self) -> None:
+        self._collection = None
+
+    def get(self):
+        if self._collection is None:
+            self._collection = bpy.utils.previews.new()
+        return self._collection
+
+    def release(self) -> None:
+        if self._collection is not None:
+            bpy.utils.previews.remove(self._collection)
+            self._collection = None
 
 
-def release() -> None:
-    if _PREVIEWS["collection"] is not None:
-        bpy.utils.previews.remove(_PREVIEWS["collection"])
-        _PREVIEWS["collection"] = None
+_DRESS = Previews()  # the Dress panel's library icons
+release = _DRESS.release
 
 
 def icon(entry: str, thumbnail: str) -> int:
     """The preview icon id of a library entry (0: none, the panel shows a plain button)."""
-    previews = collection()
+    previews = _DRESS.get()
     if entry in previews:
         return previews[entry].icon_id
     path = thumbnail if thumbnail and os.path.isfile(thumbnail) else _builtin_swatch(entry)

@@ -20,16 +20,6 @@ FIXTURES = Path(os.environ.get("AVATAR_FIXTURES", ROOT.parent / "shared" / "fixt
 WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
 
 
-@pytest.fixture(scope="module")
-def assets():
-    from avatar.body import assets as found
-    from avatar.errors import AssetError
-
-    try:
-        found.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
-
 
 def _body(built):
     from avatar.blender import live, mesh

@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 
 import pytest
-from test_extension import assets, extension_zip, human, installed  # noqa: F401
 
 
 def test_the_panel_registers_after_the_others(installed):  # noqa: F811

@@ -3,7 +3,6 @@ properties work on real characters (MakeHuman assets; skipped without them)."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import resource
@@ -21,52 +20,7 @@ FIXTURES = Path(os.environ.get("AVATAR_FIXTURES", ROOT.parent / "shared" / "fixt
 WALK = FIXTURES / "bvh" / "cmu_motionbuilder" / "02_01_walk.bvh"
 
 
-def load_build_script():
-    spec = importlib.util.spec_from_file_location("avatar_addon_build", ROOT / "addon/build.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.fixture(scope="module")
-def extension_zip(tmp_path_factory):
-    # --no-wheel: the tests import `avatar` from this checkout; the wheel step is pip's job.
-    out = tmp_path_factory.mktemp("dist")
-    return load_build_script().main(["--output", str(out), "--no-wheel"])
-
-
-@pytest.fixture(scope="module")
-def installed(extension_zip):
-    import bpy
-
-    result = bpy.ops.extensions.package_install_files(
-        filepath=str(extension_zip), repo="user_default", enable_on_install=True
-    )
-    assert result == {"FINISHED"}
-    yield
-    bpy.ops.preferences.addon_disable(module="bl_ext.user_default.avatar_addon")
-
-
-@pytest.fixture(scope="module")
-def assets():
-    from avatar.body import assets as found
-    from avatar.errors import AssetError
-
-    try:
-        found.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
-
-
-@pytest.fixture
-def human(installed, assets, empty_scene):
-    """A new human made by the operator, active, settled (exact garments)."""
-    import bpy
-
-    assert bpy.ops.avatar.create_human() == {"FINISHED"}
-    root = bpy.context.view_layer.objects.active
-    assert bpy.ops.avatar.settle() == {"FINISHED"}
-    return root
+from extension_fixtures import load_build_script  # noqa: E402,F401 - the envs tests use it
 
 
 def _state(root):

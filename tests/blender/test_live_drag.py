@@ -23,32 +23,6 @@ BODY_TOLERANCE = 1e-4  # 0.1 mm: the body and joints shown during a drag
 GARMENT_TOLERANCE = 5e-3  # the real-time garment fit before settling (test_extension)
 
 
-@pytest.fixture(scope="module")
-def installed(tmp_path_factory):
-    import bpy
-
-    spec = importlib.util.spec_from_file_location("avatar_addon_build", ROOT / "addon/build.py")
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
-    # --no-wheel: the tests import `avatar` from this checkout.
-    zip_path = build.main(["--output", str(tmp_path_factory.mktemp("dist")), "--no-wheel"])
-    result = bpy.ops.extensions.package_install_files(
-        filepath=str(zip_path), repo="user_default", enable_on_install=True
-    )
-    assert result == {"FINISHED"}
-    yield
-    bpy.ops.preferences.addon_disable(module=ADDON)
-
-
-@pytest.fixture(scope="module")
-def assets():
-    from avatar.body import assets as found
-    from avatar.errors import AssetError
-
-    try:
-        found.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
 
 
 @pytest.fixture

@@ -6,7 +6,6 @@ an Action, fuzzed packets, a port in use, a deleted character, and the port free
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import socket
 import sys
@@ -16,10 +15,6 @@ import time
 import numpy as np
 import pytest
 import test_extension
-from test_extension import ROOT
-
-# the extension's own fixtures: installed zip, assets, a new human made by the operator
-assets, human, installed = test_extension.assets, test_extension.human, test_extension.installed
 
 pytest.importorskip("pythonosc")
 from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder  # noqa: E402
@@ -35,19 +30,6 @@ IDENTITY = [0.0, 0.0, 0.0, 1.0]  # Unity quaternion order: x, y, z, w
 BEND = [0.0, S, 0.0, S]
 HIPS_AT = [0.0, 0.95, 0.2]  # Unity: 0.95 m up, 0.2 m forward -> Avatar (0, -0.2, 0.95)
 
-
-@pytest.fixture(scope="module")
-def extension_zip(tmp_path_factory):
-    """The zip built from this checkout (``--no-wheel``: the library comes from ``src``).
-    build.py is registered in sys.modules while it runs: its dataclasses look it up."""
-    spec = importlib.util.spec_from_file_location("avatar_addon_build", ROOT / "addon/build.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    try:
-        spec.loader.exec_module(module)
-        return module.main(["--output", str(tmp_path_factory.mktemp("dist")), "--no-wheel"])
-    finally:
-        sys.modules.pop(spec.name, None)
 
 
 def _panel():

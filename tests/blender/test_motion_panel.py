@@ -27,37 +27,11 @@ ADDON = "bl_ext.user_default.avatar_addon"
 needs_clips = pytest.mark.skipif(not WALK.is_file(), reason="needs the CMU BVH fixtures")
 
 
-@pytest.fixture(scope="module")
-def installed(tmp_path_factory):
-    import bpy
-
-    spec = importlib.util.spec_from_file_location("avatar_addon_build", ROOT / "addon/build.py")
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
-    # --no-wheel: the tests import `avatar` from this checkout.
-    zip_path = build.main(["--output", str(tmp_path_factory.mktemp("dist")), "--no-wheel"])
-    result = bpy.ops.extensions.package_install_files(
-        filepath=str(zip_path), repo="user_default", enable_on_install=True
-    )
-    assert result == {"FINISHED"}
-    yield
-    bpy.ops.preferences.addon_disable(module=ADDON)
-
-
-@pytest.fixture(scope="module")
-def assets():
-    from avatar.body import assets as found
-    from avatar.errors import AssetError
-
-    try:
-        found.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
 
 
 @pytest.fixture
-def human(installed, assets, empty_scene):
-    """A new rigged human (hair, brows, lashes), active, settled; fresh panel settings."""
+def human(human):
+    """The shared new human (conftest), with fresh Motion panel settings."""
     import bpy
 
     settings = bpy.context.scene.avatar_motion
@@ -65,10 +39,7 @@ def human(installed, assets, empty_scene):
         setattr(settings, name, "")
     settings.custom_map, settings.custom_table, settings.match_names = False, "{}", True
     settings.frame_start = settings.frame_end = 0
-    assert bpy.ops.avatar.create_human() == {"FINISHED"}
-    root = bpy.context.view_layer.objects.active
-    assert bpy.ops.avatar.settle() == {"FINISHED"}
-    return root
+    return human
 
 
 def _settings():

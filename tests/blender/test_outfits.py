@@ -9,15 +9,7 @@ import os
 
 import numpy as np
 import pytest
-from test_extension import (  # noqa: F401
-    _assert_matches_fresh_human,
-    _assert_same_state,
-    _state,
-    assets,
-    extension_zip,
-    human,
-    installed,
-)
+from test_extension import _assert_matches_fresh_human, _assert_same_state, _state
 
 
 def _part(root, name):
