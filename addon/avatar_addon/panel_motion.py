@@ -697,7 +697,7 @@ def _draw_report(layout, root):
     box.label(text="Retarget quality", icon="INFO")
     column = box.column(align=True)
     for label, value, alert in rows:
-        split = column.split(factor=0.38)
+        split = column.split(factor=0.34)  # report_card's labels: 10 characters at most
         split.label(text=label, icon="ERROR" if alert else "CHECKMARK")
         split.label(text=value)
 

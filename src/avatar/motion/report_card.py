@@ -58,32 +58,44 @@ def card(report: RetargetReport) -> dict:
     return out
 
 
+LABEL_CHARS = 10  # what the sidebar's label column shows at its default width
+VALUE_CHARS = 24  # and its value column: longer text is cut off with an ellipsis
+
+
 def lines(data: dict) -> list[tuple[str, str, bool]]:
-    """(label, value, alert) rows of a ``card`` for display, in reading order."""
-    rows = [("Clip", f"{data.get('frames', 0)} frames at {data.get('fps', 0):g} fps", False),
-            ("Mapping", f"{data.get('source', '?')}: {data.get('mapped', 0)} bones, "
-                        f"scale {data.get('scale', 1.0):.2f}", False)]  # fmt: skip
+    """(label, value, alert) rows of a ``card`` for display, in reading order: labels of at
+    most ``LABEL_CHARS`` and values of at most ``VALUE_CHARS`` characters, so that nothing
+    is cut off in Blender's sidebar at its default width."""
+    rows = [("Clip", f"{data.get('frames', 0)} frames, {data.get('fps', 0):.0f} fps", False),
+            ("Source", str(data.get("source", "?")), False),
+            ("Mapping", f"{data.get('mapped', 0)} bones, scale {data.get('scale', 1.0):.2f}",
+             False)]  # fmt: skip
     if "direction_median" in data:
         p95 = data["direction_p95"]
-        rows.append(("Direction error", f"median {data['direction_median']:.1f} deg, p95 "
-                     f"{p95:.1f} deg", p95 > DIRECTION_ALERT_DEG))  # fmt: skip
+        rows.append(("Direction", f"{data['direction_median']:.1f}\u00b0 (p95 {p95:.1f}\u00b0)",
+                     p95 > DIRECTION_ALERT_DEG))  # fmt: skip
         if data.get("worst_bone"):
-            rows.append(("Worst bone", f"{data['worst_bone']} {data['worst_deg']:.1f} deg",
+            rows.append(("Worst bone", f"{data['worst_bone']} {data['worst_deg']:.0f}\u00b0",
                          data["worst_deg"] > DIRECTION_ALERT_DEG))  # fmt: skip
-        rows.append(("Foot skating", f"{data['skating_cm']:.2f} cm/frame over "
-                     f"{data['contact_frames']} contacts",
-                     data["skating_cm"] > SKATING_ALERT_CM))  # fmt: skip
-        rows.append(("Joint limits", f"{data['limit_violations']} frames bent backwards",
-                     data["limit_violations"] > 0))  # fmt: skip
+        rows.append(("Skating", f"{data['skating_cm']:.2f} cm/frame "
+                     f"({data['contact_frames']})", data["skating_cm"] > SKATING_ALERT_CM))
+        bent = data["limit_violations"]
+        rows.append(("Limits", f"{bent} frames bent back" if bent else "none bent back",
+                     bent > 0))  # fmt: skip
     if "floor_penetration_cm" in data:
-        rows.append(("Floor", f"{data['floor_penetration_cm']:.2f} cm below, in "
-                     f"{data['floor_penetrating'] * 100:.0f}% of frames",
+        rows.append(("Floor", f"{data['floor_penetration_cm']:.2f} cm below, "
+                     f"{data['floor_penetrating'] * 100:.0f}%",
                      data["floor_penetration_cm"] > FLOOR_ALERT_CM))  # fmt: skip
-        rows.append(("Feet hover", f"{data['hover_cm']:.2f} cm (max {data['hover_max_cm']:.2f})",
+        rows.append(("Hover", f"{data['hover_cm']:.2f} cm, max {data['hover_max_cm']:.2f}",
                      data["hover_cm"] > HOVER_ALERT_CM))  # fmt: skip
     elif "feet_below_cm" in data:
         rows.append(("Floor", f"feet {data['feet_below_cm']:.2f} cm below",
                      data["feet_below_cm"] > FLOOR_ALERT_CM))  # fmt: skip
     if data.get("deformed"):
-        rows.append(("Skin stretch", "over limit: " + ", ".join(data["deformed"][:4]), True))
-    return rows
+        more = len(data["deformed"]) - 1
+        rows.append(("Stretch", data["deformed"][0] + (f" +{more}" if more else ""), True))
+    return [(label, _fit(value), alert) for label, value, alert in rows]
+
+
+def _fit(value: str) -> str:
+    return value if len(value) <= VALUE_CHARS else value[: VALUE_CHARS - 1] + "\u2026"
