@@ -222,3 +222,63 @@ def test_cap_sits_on_the_head_at_the_back_and_snug_at_the_brow(params):
     assert gap.min() > 0.002
     assert gap[back].mean() < 0.0085 and gap[front].mean() < 0.008, (gap[back].mean(),
                                                                       gap[front].mean())
+
+
+# ---------------------------------------------------------------------------- hood
+
+
+def _hoodie_parts(body):
+    top_piece = builtin._tights(body, builtin.top(0.95, neck=-builtin.HOODIE_NECK, hem=-0.02),
+                                builtin.sleeve_ease(0.013, 0.012), 0.03)  # fmt: skip
+    return top_piece.mesh, builtin._hood_collar(body, top_piece.mesh).mesh
+
+
+@pytest.mark.parametrize("params", [None, {"gender": 0.0, "age": 0.12},
+                                    {"gender": 1.0, "weight": 1.0, "muscle": 0.8}])  # fmt: skip
+def test_hood_joins_a_crossover_neckline_all_round_the_neck(params):
+    """The hood's edge lies round the neck over the hoodie's neckline (it lay flat on the
+    back with a bare tube of a neck in front): a roll at every angle round the neck,
+    running down the front into a V where the wearer's left half crosses over the right,
+    the drawstrings coming out of it."""
+    body = library.authoring_body() if params is None else AuthoringBody(Human(params).body)
+    m = body.marks
+    top_mesh, collar = _hoodie_parts(body)
+    v = collar.vertices.astype(np.float64)
+    angle = np.degrees(np.arctan2(v[:, 0], m.neck[1] - v[:, 1]))
+    covered = np.unique(((angle + 180) // 15).astype(int) % 24)
+    assert len(covered) == 24  # all round the neck
+    front = np.abs(angle) < 20
+    v_depth = m.neck[2] - v[front, 2].min()
+    assert 0.05 < v_depth < 0.11, v_depth  # a V, not a turtleneck
+    back = np.abs(angle) > 160
+    assert np.abs(v[back, 2].mean() - m.neck[2]) < 0.05  # round the back of the neck
+    half = len(v) // 2  # the left half first
+    left, right = v[:half], v[half:]
+    assert left[:, 0].min() < -0.01 and right[:, 0].max() > 0.01  # the ends cross
+    low = m.neck[2] - 0.06
+    crossing_left = left[(left[:, 2] < low) & (np.abs(left[:, 0]) < 0.02)]
+    crossing_right = right[(right[:, 2] < low) & (np.abs(right[:, 0]) < 0.02)]
+    assert crossing_left[:, 1].min() < crossing_right[:, 1].min() - 0.002  # left over right
+    thick = np.ptp(v[back], axis=0).min()
+    assert thick > 0.012  # a roll with thickness, not a flat band
+    # Outside the skin and the hoodie's neckline everywhere.
+    assert body.skin_tree.query(v)[0].min() > 0.008
+    cords = builtin._drawstrings(body).mesh.vertices
+    tops = [cords[:len(cords) // 2][:6].mean(axis=0), cords[len(cords) // 2:][:6].mean(axis=0)]
+    from scipy.spatial import cKDTree
+
+    assert max(cKDTree(v).query(np.array(tops))[0]) < 0.025  # they come out of the collar
+
+
+def test_hood_bag_has_volume_on_the_upper_back():
+    """Lying down, the hood is a bag with air in it: its middle stands 3.5 cm and more off
+    the back (a flat disc before), its outline settles onto the back and shoulders."""
+    body = library.authoring_body()
+    m = body.marks
+    hood = builtin._hood(body).mesh.vertices.astype(np.float64)
+    d = body.skin_tree.query(hood)[0]
+    middle = (np.abs(hood[:, 0]) < 0.04) & (hood[:, 2] < m.neck[2] - 0.06) & (
+        hood[:, 2] > m.neck[2] - 0.16)  # fmt: skip
+    assert np.percentile(d[middle], 90) > 0.05
+    outline = np.abs(hood[:, 0]) > 0.8 * np.abs(hood[:, 0]).max()
+    assert np.median(d[outline]) < np.median(d[middle]) - 0.01

@@ -238,7 +238,7 @@ def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
     thickness. Modelled as a grid over the back (the helper mesh is too coarse to cut a
     point from), each point the back's surface plus the hood's puff, then bound to it."""
     m = body.marks
-    low, high = m.neck[2] - 0.24, m.neck[2] + 0.035
+    low, high = m.neck[2] - 0.24, m.neck[2] + 0.005  # its top tucked under the collar
 
     def half_width(d):
         """m either side of the spine at depth d (0 at the neck, 1 at the tip)."""
@@ -262,7 +262,10 @@ def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
     edge = np.abs(np.broadcast_to(u, (down, across)))
     rim = np.exp(-(((1 - edge) / 0.22) ** 2)) * np.clip(d * 4, 0, 1)  # the rolled opening
     pouch = np.sin(np.pi * np.clip(d, 0, 1)) ** 0.8  # the hood's bag lying on the back
-    puff = 0.021 + 0.014 * pouch + 0.02 * rim  # over the hoodie (1.3 cm ease, 4 mm thick)
+    # Domed across as well as down: the bag's two layers hold air, up to 4 cm over the
+    # back, settling to the rolled rim at its outline (over the hoodie: 2.1 cm at least).
+    dome = np.sqrt(np.clip(1 - np.broadcast_to(u, (down, across)) ** 2, 0, 1))
+    puff = 0.021 + (0.008 + 0.028 * dome) * pouch + 0.016 * rim
     points = np.stack([x, (grid + puff).ravel(), z], -1)
     points = shoes._at_least(body, points, 0.019)  # clear of the skin and the hoodie
     index = np.arange(down * across).reshape(down, across)
@@ -334,10 +337,99 @@ def _kangaroo_pocket(ff, m):
             & (z > m.hip[0, 2] + 0.01) & (z < m.hip[0, 2] + 0.17))  # fmt: skip
 
 
+HOODIE_NECK = 0.0  # m the hoodie's body reaches above the neck joint (under the collar)
+COLLAR_V = 0.075  # m below the neck joint where the hood's two front edges cross
+
+
+def neckline(mesh: Mesh, neck: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The neck opening of a top: (centre (2,) xy, radius (A,) m and height (A,) z at the
+    angles ``NECK_ANGLES`` round it, 0 the front, + the wearer's left), from the open edge
+    of ``mesh`` nearest the neck joint ``neck`` (3,)."""
+    from avatar.geometry.shell import boundary_edges
+
+    v = mesh.vertices.astype(np.float64)
+    rim = np.unique(boundary_edges(mesh.faces)[0])
+    rim = rim[(np.abs(v[rim, 2] - neck[2]) < 0.08) & (np.hypot(v[rim, 0], v[rim, 1] - neck[1])
+                                                      < 0.12)]  # fmt: skip
+    p = v[rim]
+    centre = np.array([0.0, p[:, 1].mean()])
+    angle = np.arctan2(p[:, 0], centre[1] - p[:, 1])
+    order = np.argsort(angle)
+    a = np.concatenate([angle[order] - 2 * np.pi, angle[order], angle[order] + 2 * np.pi])
+    r = np.tile(np.hypot(p[order, 0], p[order, 1] - centre[1]), 3)
+    z = np.tile(p[order, 2], 3)
+    return centre, np.interp(NECK_ANGLES, a, r), np.interp(NECK_ANGLES, a, z)
+
+
+NECK_ANGLES = np.linspace(-np.pi, np.pi, 73)
+
+
+def _tube(path: np.ndarray, outward: np.ndarray, radii: np.ndarray, segments: int = 10,
+          ) -> Mesh:  # fmt: skip
+    """A closed tube along ``path`` (P, 3): elliptic rings of ``radii`` (P, 2) (along
+    ``outward`` (P, 3), then across it), capped at both ends, faces out."""
+    t = np.gradient(path, axis=0)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    n = outward - np.einsum("pd,pd->p", outward, t)[:, None] * t
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    b = np.cross(t, n)
+    a = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    rings = (path[:, None] + np.cos(a)[None, :, None] * (radii[:, 0, None] * n)[:, None]
+             + np.sin(a)[None, :, None] * (radii[:, 1, None] * b)[:, None])  # fmt: skip
+    count = len(path)
+    idx = np.arange(count * segments).reshape(count, segments)
+    faces = [[idx[k, j], idx[k, (j + 1) % segments], idx[k + 1, (j + 1) % segments],
+              idx[k + 1, j]] for k in range(count - 1) for j in range(segments)]  # fmt: skip
+    points = np.concatenate([rings.reshape(-1, 3), path[[0, -1]]])
+    ends = (count * segments, count * segments + 1)
+    faces += [[idx[0, (j + 1) % segments], idx[0, j], ends[0], ends[0]] for j in range(segments)]
+    faces += [[idx[-1, j], idx[-1, (j + 1) % segments], ends[1], ends[1]] for j in range(segments)]
+    mesh = _out_of(Mesh(points.astype(np.float32), np.asarray(faces, np.int32)), path)
+    return with_box_uvs(mesh)
+
+
+def _hood_collar(body: AuthoringBody, top_mesh: Mesh) -> Piece:
+    """The hood's opening edge lying round the neck as a soft roll over the hoodie's
+    neckline: two halves from the back of the neck round the sides, down the front into
+    a crossover V ``COLLAR_V`` below the neck joint, the wearer's left half over the right.
+    Each half is an elliptic tube (the folded double layer of the hood's edge with its
+    drawstring channel), kept clear of the skin and the hoodie."""
+    from avatar.clothes import shoes
+
+    m = body.marks
+    centre, radius, height = neckline(top_mesh, m.neck)
+    pieces = []
+    for side in (1, -1):
+        a = np.linspace(side * np.pi, side * np.radians(4), 40)  # back centre -> front
+        r = np.interp(a, NECK_ANGLES, radius)
+        z = np.interp(a, NECK_ANGLES, height)
+        front = np.clip(1 - np.abs(a) / np.radians(70), 0, 1)  # 0 at the sides, 1 in front
+        direction = np.stack([np.sin(a), -np.cos(a), np.zeros_like(a)], -1)
+        path = np.concatenate([centre, [0.0]]) + (r + 0.012)[:, None] * direction
+        rest = z + 0.008  # on the neckline, its lower edge over the hoodie's
+        path[:, 2] = rest + (m.neck[2] - COLLAR_V - rest) * front**1.6
+        # The front ends run past the middle: the left half crosses over the right.
+        path[:, 0] -= side * 0.02 * front**3
+        lift = 0.003 + (0.009 if side > 0 else 0.0) * front**2
+        radii = np.stack([0.0085 + 0.002 * (1 - front), 0.013 - 0.004 * front**2], -1)
+        # The roll's centre clears the skin by its own size (over the hoodie and, at the
+        # back, over the bag's top); the per-vertex push below only mops up.
+        path = shoes._at_least(body, path, 0.012 + 0.004 * (1 - front) + radii.max(axis=1) + lift)
+        outward = np.concatenate([direction[:, :2], np.full((len(a), 1), 0.5)], 1)
+        tube = _tube(path, outward, radii)
+        ring_lift = np.concatenate([np.repeat(lift, 10), lift[[0, -1]]])
+        points = shoes._at_least(body, tube.vertices.astype(np.float64), 0.008 + ring_lift)
+        tube = Mesh(points.astype(np.float32), tube.faces, tube.uvs, tube.face_uvs)
+        pieces.append(bound(body, tube, body.group_faces("helper-tights")))
+    return join(pieces)
+
+
 def _hoodie(body: AuthoringBody) -> Piece:
-    top_piece = _tights(body, top(0.95, neck=-0.02, hem=-0.02), sleeve_ease(0.013, 0.012), 0.03)
+    top_piece = _tights(body, top(0.95, neck=-HOODIE_NECK, hem=-0.02), sleeve_ease(0.013, 0.012),
+                        0.03)  # fmt: skip
     pocket = _tights(body, _kangaroo_pocket, 0.017, 0.012)
-    return join([top_piece, pocket, _hood(body), _drawstrings(body)])
+    collar = _hood_collar(body, top_piece.mesh)
+    return join([top_piece, pocket, _hood(body), collar, _drawstrings(body)])
 
 
 def _skirt_ease(body: AuthoringBody, base: float, extra: float):
