@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import functools
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
 
@@ -35,6 +36,8 @@ from avatar.motion import bonemap, geometry, poselib
 from avatar.rig import quaternion
 from avatar.rig.kinematics import rest_quaternions, world_pose
 from avatar.rig.skeleton import Skeleton
+
+Vector = Sequence[float] | np.ndarray  # a 3- or 4-vector: floats as received, or an array
 
 M = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 """Unity vector -> Avatar vector (``M @ v``); its inverse is its transpose."""
@@ -47,13 +50,13 @@ def human_bones() -> tuple[tuple[str, str | None, str | None], ...]:
     return tuple((b[0], b[1], b[2]) for b in json.loads(text)["bones"])
 
 
-def to_avatar_vector(v: np.ndarray) -> np.ndarray:
+def to_avatar_vector(v: Vector) -> np.ndarray:
     """(..., 3) Unity positions -> Avatar's."""
     v = np.asarray(v, dtype=np.float64)
     return np.stack([-v[..., 0], -v[..., 2], v[..., 1]], axis=-1)
 
 
-def to_unity_vector(v: np.ndarray) -> np.ndarray:
+def to_unity_vector(v: Vector) -> np.ndarray:
     """(..., 3) Avatar positions -> Unity's."""
     v = np.asarray(v, dtype=np.float64)
     return np.stack([-v[..., 0], v[..., 2], -v[..., 1]], axis=-1)
@@ -77,10 +80,11 @@ class UnityPose:
 
     root: (position (3,), rotation (4,) xyzw) of the model.
     bones: HumanBodyBones name -> (localPosition (3,), localRotation (4,) xyzw).
+    Each a 3- or 4-sequence of floats (tuples as received, arrays as ``to_unity`` makes).
     """
 
-    root: tuple[np.ndarray, np.ndarray]
-    bones: dict[str, tuple[np.ndarray, np.ndarray]]
+    root: tuple[Vector, Vector]
+    bones: dict[str, tuple[Vector, Vector]]
 
 
 class UnityRig:
@@ -109,6 +113,36 @@ class UnityRig:
             j = int(skeleton.parents[j])
         self.above_hips = np.array(above, dtype=int)  # bones that stay at rest
         self.leg = _leg(t_heads, bmap)
+        # What a frame's conversion needs, prepared once (both directions work on all bones
+        # at once: a handful of numpy calls a tree level, not a product per bone).
+        self._identity_xyzw = np.tile([0.0, 0.0, 0.0, 1.0], (len(self.names), 1))
+        if self.shares:
+            share = np.array([sh[:3] for sh in self.shares], dtype=int)
+            self._share_bone, self._share_lo, self._share_hi = share.T
+            self._share_f = np.array([sh[3] for sh in self.shares])
+        parents = skeleton.parents
+        self._has_parent = np.flatnonzero(parents >= 0)
+        self._parent_of = parents[self._has_parent]
+        self._local_rest_c = self.local_rest[self._has_parent]
+        self._t_rot_inverse = _conjugate(self.t_rot)
+        mapped = np.flatnonzero(self.bone_of >= 0)
+        self._mapped, self._mapped_bones = mapped, self.bone_of[mapped]
+        # Per Unity bone: the nearest mapped bone at or above it (-1: none, identity turn).
+        nearest = np.full(len(self.names), -1)
+        for u, p in enumerate(self.unity_parent):  # parents precede children
+            nearest[u] = u if self.bone_of[u] >= 0 else (nearest[p] if p >= 0 else -1)
+        self._nearest = nearest
+        sent_parent = np.array([self.unity_parent[u] for u in mapped])
+        self._sent_parent = sent_parent
+        self._sent_names = [self.names[u] for u in mapped]
+        self._sent_root = [i for i, u in enumerate(mapped) if self.unity_parent[u] < 0]
+        positions = np.zeros((len(mapped), 3))
+        for i, m in enumerate(mapped.tolist()):  # T-pose offsets from the mapped bone above
+            if self.unity_parent[m] >= 0:
+                over = self._mapped_above(m)
+                ref = self.t_heads[self.bone_of[over]] if over >= 0 else np.zeros(3)
+                positions[i] = to_unity_vector(self.t_heads[self.bone_of[m]] - ref)
+        self._sent_positions = positions
 
     def _map(self, skeleton: Skeleton, bmap: bonemap.BoneMap) -> np.ndarray:
         out = np.full(len(self.names), -1)
@@ -150,42 +184,41 @@ class UnityRig:
 
     def from_unity(self, pose: UnityPose) -> tuple[np.ndarray, np.ndarray]:
         """A VMC pose -> (J, 4) pose-bone rotations and (J, 3) locations on this rig."""
-        n = len(self.names)
-        local = np.zeros((n, 4))
-        local[:, 3] = 1.0
-        for name, (_, q) in pose.bones.items():
-            local[self._index[name]] = q
-        local = to_avatar_quaternion(local)
-        turn = np.empty((n, 4))  # D per Unity bone, Avatar's axes
-        root_q = to_avatar_quaternion(pose.root[1])
+        local = self._identity_xyzw.copy()
+        bones = pose.bones
+        if bones:
+            index = self._index
+            local[[index[name] for name in bones]] = [q for _, q in bones.values()]
+        local = local[:, _TO_AVATAR] * _TO_AVATAR_SIGN  # to_avatar_quaternion
+        root = np.asarray(pose.root[1], dtype=np.float64)
+        root_q = root[_TO_AVATAR] * _TO_AVATAR_SIGN
+        turn = np.empty_like(local)  # D per Unity bone, Avatar's axes
         for level, parents in self._levels:  # a tree level at a time: ~8 products, not 55
-            ahead = root_q if parents is None else turn[parents]
-            turn[level] = quaternion.multiply(ahead, local[level])
+            turn[level] = _multiply(turn[parents] if parents is not None else root_q[None],
+                                    local[level])  # fmt: skip
         d = turn[self.source]
-        for bone, lo, hi, f in self.shares:
-            d[bone] = quaternion.slerp(turn[lo], turn[hi], f)
-        world = quaternion.multiply(d, self.t_rot)
+        if self.shares:
+            d[self._share_bone] = quaternion.slerp(turn[self._share_lo], turn[self._share_hi],
+                                                   self._share_f)  # fmt: skip
+        world = _multiply(d, self.t_rot)
         world[self.above_hips] = self.t_rot[self.above_hips]
         rotations = self._locals(world)
         translations = np.zeros((len(self.skeleton.names), 3))
-        hips = pose.bones.get("Hips")
+        hips = bones.get("Hips")
         if hips is not None:
-            rq = np.asarray(pose.root[1], dtype=np.float64)
-            pos = to_avatar_vector(pose.root[0]) + quaternion.rotate(
-                to_avatar_quaternion(rq), to_avatar_vector(hips[0])
+            at = to_avatar_vector(pose.root[0]) + quaternion.rotate(
+                root_q, to_avatar_vector(hips[0])
             )
-            pos = pos * self._scale(pose)
+            at = at * self._scale(pose)
             translations[self.hips] = quaternion.rotate(
-                quaternion.conjugate(self.rest_rot[self.hips]), pos - self.skeleton.heads[self.hips]
+                quaternion.conjugate(self.rest_rot[self.hips]), at - self.skeleton.heads[self.hips]
             )
         return rotations, translations
 
     def _locals(self, world: np.ndarray) -> np.ndarray:
-        parents = self.skeleton.parents
-        has = parents >= 0
         base = self.local_rest.copy()
-        base[has] = quaternion.multiply(world[parents[has]], self.local_rest[has])
-        out = quaternion.multiply(quaternion.conjugate(base), world)
+        base[self._has_parent] = _multiply(world[self._parent_of], self._local_rest_c)
+        out = _multiply(_conjugate(base), world)
         return out * np.where(out[:, :1] < 0, -1.0, 1.0)
 
     def _scale(self, pose: UnityPose) -> float:
@@ -201,28 +234,22 @@ class UnityRig:
         """(J, 4) pose-bone rotations and (J, 3) locations on this rig -> a VMC pose."""
         world, heads = world_pose(self.skeleton, rotations[None], translations[None])
         world, heads = world[0], heads[0]
-        n = len(self.names)
-        turn = np.empty((n, 4))
-        for u in range(n):
-            b, p = self.bone_of[u], self.unity_parent[u]
-            if b >= 0:
-                turn[u] = quaternion.multiply(world[b], quaternion.conjugate(self.t_rot[b]))
-            else:
-                turn[u] = (1.0, 0.0, 0.0, 0.0) if p < 0 else turn[p]
-        bones = {}
-        for u in range(n):
-            b, p = self.bone_of[u], self.unity_parent[u]
-            if b < 0:
-                continue
-            parent_turn = np.array([1.0, 0.0, 0.0, 0.0]) if p < 0 else turn[p]
-            local = quaternion.multiply(quaternion.conjugate(parent_turn), turn[u])
-            if p < 0:
-                position = to_unity_vector(heads[b])
-            else:
-                above = self._mapped_above(u)
-                ref = self.t_heads[self.bone_of[above]] if above >= 0 else np.zeros(3)
-                position = to_unity_vector(self.t_heads[b] - ref)
-            bones[self.names[u]] = (position, to_unity_quaternion(local))
+        # Each Unity bone's turn from the T-pose: its mapped bone's, or the nearest mapped
+        # one's above it (identity above all of them).
+        mapped_turn = _multiply(world[self._mapped_bones], self._t_rot_inverse[self._mapped_bones])
+        turn = np.tile([1.0, 0.0, 0.0, 0.0], (len(self.names), 1))
+        nearest = self._nearest
+        has = nearest >= 0
+        where = np.searchsorted(self._mapped, nearest[has])
+        turn[has] = mapped_turn[where]
+        parent_turn = np.where((self._sent_parent >= 0)[:, None], turn[self._sent_parent],
+                               [1.0, 0.0, 0.0, 0.0])  # fmt: skip
+        local = _multiply(_conjugate(parent_turn), mapped_turn)
+        quats = to_unity_quaternion(local)
+        positions = self._sent_positions.copy()
+        for i in self._sent_root:
+            positions[i] = to_unity_vector(heads[self._mapped_bones[i]])
+        bones = dict(zip(self._sent_names, zip(positions, quats, strict=True), strict=True))
         return UnityPose((np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])), bones)
 
     def _mapped_above(self, u: int) -> int:
@@ -230,6 +257,35 @@ class UnityRig:
         while p >= 0 and self.bone_of[p] < 0:
             p = self.unity_parent[p]
         return p
+
+
+# Unity (x, y, z, w) -> Avatar (w, x, y, z) as a gather and a sign: (w, x, z, -y).
+_TO_AVATAR = np.array([3, 0, 2, 1])
+_TO_AVATAR_SIGN = np.array([1.0, 1.0, 1.0, -1.0])
+# The Hamilton product as one contraction: out[k] = sum_ij a[i] b[j] _HAMILTON[i, j, k].
+_HAMILTON = np.zeros((4, 4, 4))
+for _k, _terms in enumerate((
+        ((0, 0, 1), (1, 1, -1), (2, 2, -1), (3, 3, -1)),
+        ((0, 1, 1), (1, 0, 1), (2, 3, 1), (3, 2, -1)),
+        ((0, 2, 1), (1, 3, -1), (2, 0, 1), (3, 1, 1)),
+        ((0, 3, 1), (1, 2, 1), (2, 1, -1), (3, 0, 1)))):  # fmt: skip
+    for _i, _j, _sign in _terms:
+        _HAMILTON[_i, _j, _k] = _sign
+_HAMILTON_FLAT = _HAMILTON.reshape(16, 4)
+
+
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products of (n, 4) quaternions ((1, 4) broadcasts): ``quaternion.multiply``
+    in two numpy calls (for a few dozen rows its per-component form is 36 calls)."""
+    n = max(len(a), len(b))
+    return np.dot((a[:, :, None] * b[:, None, :]).reshape(n, 16), _HAMILTON_FLAT)
+
+
+def _conjugate(q: np.ndarray) -> np.ndarray:
+    return q * _CONJUGATE
+
+
+_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def _levels(parents: list[int]) -> list[tuple[np.ndarray, np.ndarray | None]]:

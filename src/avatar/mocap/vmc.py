@@ -27,14 +27,13 @@ from __future__ import annotations
 import logging
 import math
 import socket
-from collections.abc import Iterable
+from collections.abc import Sequence
 
-import numpy as np
 from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
 from pythonosc.osc_message_builder import OscMessageBuilder
-from pythonosc.osc_packet import OscPacket
 
 from avatar.errors import ParameterError
+from avatar.mocap import osc
 from avatar.mocap.stream import Frame, UdpSource
 from avatar.mocap.unity import UnityPose, human_bones
 
@@ -56,29 +55,34 @@ def parse_address(text: str, default_host: str = "127.0.0.1") -> tuple[str, int]
     return (host.strip("[]") or default_host), number
 
 
-def _numbers(args: Iterable, count: int) -> list[float] | None:
+def _numbers(args: Sequence, count: int) -> list[float] | None:
+    """``count`` finite numbers (int or float, not bool) as floats, or None."""
+    if len(args) != count:
+        return None
     out = []
     for a in args:
         if isinstance(a, bool) or not isinstance(a, (int, float)):
             return None
-        out.append(float(a))
-    if len(out) != count or not all(math.isfinite(v) for v in out):
-        return None
+        v = float(a)
+        if v - v != 0.0:  # inf or NaN
+            return None
+        out.append(v)
     return out
 
 
-def _pose_args(params: list) -> tuple[str, np.ndarray, np.ndarray] | None:
-    """(name, position, unit quaternion xyzw) from ``s f f f f f f f``, or None."""
+def _pose_args(params: list) -> tuple[str, tuple, tuple] | None:
+    """(name, position (3 floats), unit quaternion xyzw (4 floats)) from
+    ``s f f f f f f f``, or None."""
     if len(params) < 8 or not isinstance(params[0], str):
         return None
     values = _numbers(params[1:8], 7)
     if values is None:
         return None
-    q = np.array(values[3:7])
-    norm = float(np.linalg.norm(q))
+    px, py, pz, x, y, z, w = values
+    norm = math.sqrt(x * x + y * y + z * z + w * w)
     if not 0.5 < norm < 2.0:  # a rotation is a unit quaternion; far off is garbage
         return None
-    return params[0], np.array(values[:3]), q / norm
+    return params[0], (px, py, pz), (x / norm, y / norm, z / norm, w / norm)
 
 
 class VmcAssembler:
@@ -87,36 +91,35 @@ class VmcAssembler:
     def __init__(self, counters):
         self.counters = counters
         self.known = {b[0] for b in human_bones()}
-        self.bones: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        self.root = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+        self.bones: dict[str, tuple] = {}  # name -> (position, quaternion xyzw): floats
+        self.root: tuple = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
         self.blends: dict[str, float] = {}
         self.last_sent: float | None = None
         self._reset_pending()
 
     def _reset_pending(self) -> None:
-        self.pending_bones: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.pending_bones: dict[str, tuple] = {}
         self.pending_count = 0
-        self.pending_root: tuple[np.ndarray, np.ndarray] | None = None
+        self.pending_root: tuple | None = None
         self.pending_time: float | None = None
 
     def feed(self, datagram: bytes, arrival: float) -> list[Frame]:
         """Frames completed by one datagram (usually zero or one)."""
         self.counters.packet()
         try:
-            packet = OscPacket(datagram)
-            messages = [m.message for m in packet.messages]
-        except Exception:  # python-osc raises several types on garbage; all mean malformed
+            messages = osc.decode(datagram)
+        except osc.OscError:
             self.counters.drop("malformed")
             return []
-        if not messages:  # python-osc skips bundle elements it cannot parse, with a warning
+        if not messages:  # an empty bundle
             self.counters.drop("malformed")
             return []
         # In a bundle the frame completes at its end: senders put /VMC/Ext/T after OK.
         bundle = datagram[:8] == b"#bundle\x00"
         out: list[Frame] = []
         ok = False
-        for msg in messages:
-            if self._message(str(msg.address), list(msg.params)):
+        for address, params in messages:
+            if self._message(address, params):
                 ok = True
                 if not bundle:
                     out += self._complete(arrival)
