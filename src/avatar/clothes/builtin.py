@@ -414,7 +414,12 @@ def _hood_collar(body: AuthoringBody, top_mesh: Mesh) -> Piece:
         radii = np.stack([0.0085 + 0.002 * (1 - front), 0.013 - 0.004 * front**2], -1)
         # The roll's centre clears the skin by its own size (over the hoodie and, at the
         # back, over the bag's top); the per-vertex push below only mops up.
-        path = shoes._at_least(body, path, 0.012 + 0.004 * (1 - front) + radii.max(axis=1) + lift)
+        gap = 0.012 + 0.004 * (1 - front) + radii.max(axis=1) + lift
+        for _ in range(3):  # pushed clear, then smoothed along (no horns over the trapezius)
+            path = shoes._at_least(body, path, gap)
+            for _ in range(4):
+                path[1:-1] = 0.5 * path[1:-1] + 0.25 * (path[:-2] + path[2:])
+        path = shoes._at_least(body, path, gap)
         outward = np.concatenate([direction[:, :2], np.full((len(a), 1), 0.5)], 1)
         tube = _tube(path, outward, radii)
         ring_lift = np.concatenate([np.repeat(lift, 10), lift[[0, -1]]])
