@@ -58,10 +58,13 @@ FIXTURE = (
 BODY = ("left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist",
         "right_wrist", "left_hip", "right_hip", "left_knee", "right_knee", "left_ankle",
         "right_ankle")  # fmt: skip
-# The solver before the plain-float rewrite (numpy per dependency level, 2.2-2.6 ms/frame
-# on the 2-core container); results pinned by tests/mocap/test_solver_regression.py.
-REFERENCE = "4a19b57"
+# The solver before this round of speed-ups (plain floats, 0.66-1.2 ms/frame on the 2-core
+# container; 4a19b57 is the numpy-per-level one before it); results pinned by
+# tests/mocap/test_solver_regression.py. Also the VMC receive path at that revision
+# (python-osc's parser, Unity -> rig a product per tree level of 36 numpy calls).
+REFERENCE = "9d87694"
 MODULES = ("rotations", "filters", "feet", "plan", "solver")
+VMC_MODULES = ("stream", "unity", "osc", "vmc")
 FRAME_MS = 1000.0 / 60.0
 
 
@@ -71,26 +74,44 @@ FRAME_MS = 1000.0 / 60.0
 def reference_solver(rev: str):
     """``avatar.mocap.solver`` with the modules it leans on as they were at git revision
     ``rev``, imported as a private package (None when git or the revision is missing)."""
+    package = _reference_package(rev, MODULES, "solver")
+    return None if package is None else importlib.import_module(f"{package}.solver")
+
+
+def reference_vmc(rev: str):
+    """``avatar.mocap.vmc`` (and ``unity``, ``stream``, ``osc`` where it existed) as at git
+    revision ``rev``, as a private package: (vmc, unity) modules, or None."""
+    package = _reference_package(rev, VMC_MODULES, "vmc")
+    if package is None:
+        return None
+    return (importlib.import_module(f"{package}.vmc"), importlib.import_module(f"{package}.unity"))
+
+
+def _reference_package(rev: str, modules: tuple[str, ...], kind: str) -> str | None:
     root = Path(__file__).resolve().parents[1]
-    package = "avatar_mocap_" + "".join(c if c.isalnum() else "_" for c in rev)
+    package = f"avatar_mocap_{kind}_" + "".join(c if c.isalnum() else "_" for c in rev)
     folder = Path(tempfile.mkdtemp(prefix="avatar-bench-")) / package
     folder.mkdir()
     (folder / "__init__.py").write_text("")
-    for name in MODULES:
+    texts = {}
+    for name in modules:
         try:
-            text = subprocess.run(["git", "show", f"{rev}:src/avatar/mocap/{name}.py"],
-                                  cwd=root, check=True, capture_output=True,
-                                  text=True).stdout  # fmt: skip
+            texts[name] = subprocess.run(["git", "show", f"{rev}:src/avatar/mocap/{name}.py"],
+                                         cwd=root, check=True, capture_output=True,
+                                         text=True).stdout  # fmt: skip
         except (OSError, subprocess.CalledProcessError):
-            return None
-        for other in MODULES:
+            continue  # a module the revision did not have (nothing there imports it)
+    if kind not in texts:
+        return None
+    for name, text in texts.items():
+        for other in texts:
             text = text.replace(
                 f"from avatar.mocap import {other}", f"from {package} import {other}"
             )
             text = text.replace(f"avatar.mocap.{other}", f"{package}.{other}")
         (folder / f"{name}.py").write_text(text)
     sys.path.insert(0, str(folder.parent))
-    return importlib.import_module(f"{package}.solver")
+    return package
 
 
 def solve_ms(module, rig, truth) -> float:
@@ -134,6 +155,40 @@ def solve_times(human, clip, runs: int, reference) -> None:
             speed = [a / b for a, b in zip(got["reference"], got["solver"], strict=True)]
             line += f"; reference {old:6.3f} ms: {statistics.median(speed):4.2f}x faster"
         print(line)
+
+
+def vmc_receive_ms(vmc_module, unity_module, skeleton, datagrams: list[bytes]) -> float:
+    """CPU ms per frame of the VMC receive path without sockets: datagram -> frame
+    (``VmcAssembler``) -> rotations on the rig (``UnityRig.from_unity``)."""
+    from avatar.mocap.stream import Counters
+
+    rig = unity_module.UnityRig(skeleton)
+    assembler = vmc_module.VmcAssembler(Counters())
+    t = time.process_time()
+    for data in datagrams:
+        for frame in assembler.feed(data, 0.0):
+            rig.from_unity(frame.data)
+    return (time.process_time() - t) / len(datagrams) * 1e3
+
+
+def vmc_receive_times(human, clip, runs: int, reference) -> None:
+    """Print the VMC receive path's CPU ms per frame, against the reference revision's."""
+    from avatar.mocap import vmc
+
+    datagrams = [b.dgram for b in vmc_bundles(human.skeleton, clip, min(clip.frames, 120))]
+    got: dict[str, list[float]] = {"now": [], "reference": []}
+    for _ in range(runs):
+        got["now"].append(vmc_receive_ms(vmc, unity, human.skeleton, datagrams))
+        if reference:
+            got["reference"].append(vmc_receive_ms(*reference, human.skeleton, datagrams))
+    ms = statistics.median(got["now"])
+    line = (f"VMC receive (decode {len(datagrams[0])}-byte bundles of 55 bones + onto the rig) "
+            f"{ms:6.3f} ms/frame CPU (runs {min(got['now']):.3f}-{max(got['now']):.3f})")
+    if reference:
+        old = statistics.median(got["reference"])
+        speed = [a / b for a, b in zip(got["reference"], got["now"], strict=True)]
+        line += f"; reference {old:6.3f} ms: {statistics.median(speed):4.2f}x faster"
+    print(line)
 
 
 # -- 2. end to end ------------------------------------------------------------------------
@@ -253,7 +308,8 @@ def latencies(human, clip, runs: int, count: int = 150) -> None:
         skin = statistics.median(posing)
         print(f"latency {label:38s} median {med:5.2f} ms, 95% {p95:5.2f} ms, "
               f"worst {max(worst):5.2f} ms ({med / FRAME_MS:.2f} / {p95 / FRAME_MS:.2f} of a "
-              f"60 Hz frame; posing and skinning {skin:.2f} ms of it)")  # fmt: skip
+              f"60 Hz frame; posing and skinning {skin:.2f} ms of it; 95% per run "
+              f"{', '.join(f'{v:.1f}' for v in p95s)}; load {os.getloadavg()[0]:.1f})")  # fmt: skip
 
 
 def mediapipe_rate(video_path: str | None) -> str:
@@ -324,6 +380,8 @@ def main() -> None:
     if args.reference and reference is None:
         print(f"reference solver at {args.reference}: not available (no git or no such revision)")
     solve_times(human, clip, args.runs, reference)
+    vmc_reference = reference_vmc(args.reference) if args.reference else None
+    vmc_receive_times(human, clip, args.runs, vmc_reference)
     latencies(human, clip, args.runs)
     if not args.no_errors:
         rig = keypoints.bind("coco17", human.skeleton)

@@ -67,6 +67,10 @@ def test_serve_prints_stats_and_records_keypoints(model, tmp_path, capsys):
     import avatar
     from avatar.mocap import keypoint_stream, keypoints
 
+    # the keypoints first: on a loaded machine making a Human took most of the serve window
+    human = avatar.Human()
+    rig = keypoints.bind("coco17", human.skeleton)
+    points = rig.positions(human.pose("t-pose"))[0]
     port = _free_port()
     take = tmp_path / "served.bvh"
     status = {}
@@ -75,9 +79,6 @@ def test_serve_prints_stats_and_records_keypoints(model, tmp_path, capsys):
          "--seconds", "2.5", "-o", str(take)])))  # fmt: skip
     server.start()
     time.sleep(1.0)
-    human = avatar.Human()
-    rig = keypoints.bind("coco17", human.skeleton)
-    points = rig.positions(human.pose("t-pose"))[0]
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     for i in range(20):
         sock.sendto(keypoint_stream.encode(i, points, np.ones(17), i / 30, axes="avatar"),

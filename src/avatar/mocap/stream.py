@@ -4,12 +4,19 @@ A source runs its socket on a daemon thread and never blocks its caller: ``poll(
 returns the newest complete frame (or None) and ``take()`` every frame since the last call,
 in order (for recording at the sender's rate). Bad input is dropped and counted by reason
 in ``stats()``; nothing a sender does can raise out of the thread.
+
+UDP sources also read their socket in ``poll()``/``take()`` (non-blocking, under the lock the
+thread reads with, so datagrams are taken in order by one reader at a time): a frame that
+has arrived is handed over even when the receiving thread has not been scheduled yet. On a
+busy machine that wake-up was most of the loopback latency's 95th percentile (a thread
+switch and the GIL: 4-6 ms of p95 13 ms at load 10 on 2 cores).
 """
 
 from __future__ import annotations
 
 import collections
 import logging
+import select
 import socket
 import threading
 import time
@@ -180,8 +187,9 @@ class UdpSource(Source):
         except OSError as exc:
             self.sock.close()
             raise ParameterError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
-        self.sock.settimeout(0.05)
+        self.sock.setblocking(False)  # the thread waits in select(), readers never block
         self.address = self.sock.getsockname()
+        self._reading = threading.Lock()
 
     def feed(self, data: bytes, arrival: float) -> None:
         raise NotImplementedError
@@ -189,14 +197,51 @@ class UdpSource(Source):
     def _loop(self) -> None:
         while not self._stop.is_set():
             try:
+                ready, _, _ = select.select([self.sock], [], [], 0.05)
+            except (OSError, ValueError):  # the socket closed under us
+                if self._stop.is_set():
+                    return
+                raise
+            if ready:
+                with self._reading:
+                    self._drain(None)
+
+    def _drain(self, most: int | None) -> None:
+        """Feed the datagrams waiting in the socket (at most ``most``), oldest first; the
+        caller holds ``_reading``."""
+        count = 0
+        while most is None or count < most:
+            try:
                 data = self.sock.recv(65535)
-            except TimeoutError:
-                continue
+            except (BlockingIOError, InterruptedError):
+                return
             except OSError:
                 if self._stop.is_set():
                     return
                 raise
             self.feed(data, time.perf_counter())
+            count += 1
+
+    def _read_now(self) -> None:
+        """What has arrived, read here unless the thread is reading it right now (then it
+        hands it over): a second of 60 Hz frames at most, so a backlog cannot stall a UI."""
+        if self._stop.is_set() or not self._reading.acquire(blocking=False):
+            return
+        try:
+            self._drain(64)
+        except Exception:  # never raise into the caller: the thread's policy, counted
+            log.exception("%s: reading failed", type(self).__name__)
+            self.counters.drop("internal")
+        finally:
+            self._reading.release()
+
+    def poll(self) -> Frame | None:
+        self._read_now()
+        return super().poll()
+
+    def take(self) -> list[Frame]:
+        self._read_now()
+        return super().take()
 
     def _close(self) -> None:
         self.sock.close()
