@@ -156,7 +156,7 @@ def test_jeans_fade_at_thighs_knees_seams_and_whiskers(jeans):
     d, _, window = canvas.distance(seams.points, 12)
     near, far = lum[window][d < 2.5], lum[window][(d > 8) & (d < 12)]
     assert near.mean() > 1.12 * np.median(far)
-    whiskers = [m for m in washes if abs(m.width - 0.006) < 1e-9]
+    whiskers = [m for m in washes if abs(m.width - 0.006) < 1e-9 and len(m.points) < 12]
     assert len(whiskers) >= 8
     d, _, window = canvas.distance(whiskers[0].points, 10)
     assert lum[window][d < 1.5].mean() > 1.25 * unworn

@@ -222,6 +222,7 @@ def _dress(body: AuthoringBody) -> Piece:
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     bodice = cut(body, faces, dress_bodice(ff, body.marks), 0.004, relax=RELAX)
+    bodice = _tucked(body, bodice, 0.0025, 0.05)
     waist = float(np.percentile(bodice.vertices[:, 2], 1)) + 0.03
     bodice = banded(bodice, lambda p: np.where(p[:, 2] > waist, 0.012, 0.0))
     # The skirt's top lies over the bodice's hem (the bodice keeps 4 mm), sits on the hips
@@ -229,6 +230,21 @@ def _dress(body: AuthoringBody) -> Piece:
     skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04),
                          hug=DRESS_HUG, under=bodice.vertices, gap=0.01)
     return join([bound(body, bodice, faces), skirt_piece])
+
+
+def _tucked(body: AuthoringBody, mesh: Mesh, ease: float, reach: float) -> Mesh:
+    """The mesh with its lowest ``reach`` m laid ``ease`` m off the skin (smoothly from
+    its own ease above): a bodice's hem tucked in flat under a skirt, so the skirt's top
+    over it steps out by a seam's few millimetres, not a ledge round the waist."""
+    v = mesh.vertices.astype(np.float64)
+    bottom = float(np.percentile(v[:, 2], 1))
+    t = np.clip((bottom + reach - v[:, 2]) / reach, 0, 1)
+    w = t * t * (3 - 2 * t)
+    low = w > 0
+    off, normal = tailoring.skin_offset(body, v[low])
+    target = np.minimum(off, w[low] * ease + (1 - w[low]) * off)
+    v[low] += (target - off)[:, None] * normal
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:

@@ -260,8 +260,13 @@ def jeans_marks(panels: Panels, h: Heights) -> list[Mark]:
                 start = np.array([inner(h.crotch + 0.03)[0] + 0.045 + 0.01 * j,
                                   h.crotch + 0.025 + 0.018 * j])
                 end = start + [0.09 + 0.015 * j, 0.035 + 0.01 * j]
-                line = panels.uv(k, np.linspace(start, end, 8))
-                marks += [Mark("fold", line, 0.0035, 0.7), Mark("wash", line, 0.006, 0.6)]
+                t = np.linspace(0, 1, 12)[:, None]
+                bow = np.array([0.0, -0.008]) * np.sin(np.pi * t)  # a slight sag
+                line = panels.uv(k, start + t * (end - start) + bow)
+                # Faded most in the middle, tapering to nothing at both ends.
+                marks += [Mark("fold", line[2:-2], 0.003, 0.6),
+                          Mark("wash", line[1:-1], 0.0045, 0.3),
+                          Mark("wash", line[3:-3], 0.006, 0.45)]
             thigh = (h.crotch + h.knee) / 2
             marks += [Mark("wash", _line(panels, k, mid(h.knee + 0.03), np.array([h.knee + 0.03])),
                            0.09, 0.6),
