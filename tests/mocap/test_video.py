@@ -117,3 +117,47 @@ def test_rendered_walk_is_recovered_from_video(fixtures, model, tmp_path, capsys
     wrong = groundtruth.compare(rest, truth, solved, quarter @ axes)
     assert wrong.mpjpe > result.mpjpe + 40.0, (wrong.mpjpe, result.mpjpe)
     assert wrong.pa_mpjpe == pytest.approx(result.pa_mpjpe, rel=1e-6)  # Procrustes undoes it
+
+
+def test_ground_puts_each_frame_on_its_lowest_ankle(fixtures, rig_skeleton, clip_on):
+    """Hips-centred keypoints of the forward jumps (crouches before each jump): with
+    ``floor="ground"`` the lowest ankle of every frame stands at the rig's ankle height and,
+    where the clip has a foot on the floor, the hip joints go up and down with the clip's (a
+    crouch lowers them); with one floor for the clip ("auto") the hips stay at standing
+    height and the crouching feet float."""
+    skeleton = rig_skeleton("default")
+    clip = clip_on("default", fixtures / "bvh/cmu_motionbuilder/01_01_forward_jumps.bvh", 640)
+    rig = keypoints.bind("mediapipe33", skeleton)
+    truth = rig.positions(clip)[::4]  # 30 frames/s
+    names = rig.keypoints.names
+    hips = [names.index("left_hip"), names.index("right_hip")]
+    ankles = [names.index("left_ankle"), names.index("right_ankle")]
+    centred = truth - truth[:, hips].mean(axis=1, keepdims=True)
+    hip_truth = truth[:, hips, 2].mean(axis=1)
+    standing = truth[:, ankles, 2].min(axis=1) < truth[:, ankles, 2].min() + 0.01
+    assert np.ptp(hip_truth[standing]) > 0.08  # the clip crouches: hips 8+ cm lower
+    rest_ankle = float(np.mean([skeleton.heads[skeleton.index(n), 2]
+                                for n in ("foot.L", "foot.R")]))  # fmt: skip
+    got = {}
+    for floor in ("ground", "auto"):
+        settings = solver.SolverSettings(smoothing=filters.OneEuro.off(), floor=floor,
+                                         scale=1.0, plant_feet=False)  # fmt: skip
+        points = rig.positions(solver.solve(rig, centred, None, 30.0, settings))
+        got[floor] = (points[:, ankles, 2].min(axis=1), points[:, hips, 2].mean(axis=1))
+    lowest, hip_height = got["ground"]
+    np.testing.assert_allclose(lowest, rest_ankle, atol=0.01)
+    # the hips follow the clip's up and down (the offset: the clip's standing ankle is not
+    # quite at the rig's rest ankle height)
+    offset = hip_height[standing] - hip_truth[standing]
+    assert np.ptp(offset) < 0.02 and abs(offset.mean()) < 0.03, (np.ptp(offset), offset.mean())
+    lowest_auto, _ = got["auto"]
+    assert (lowest_auto[standing] - rest_ankle).max() > 0.04  # floating feet, before
+
+
+def test_a_floor_that_is_not_one_is_a_clear_error(rig_skeleton):
+    from avatar.errors import ParameterError
+
+    rig = keypoints.bind("coco17", rig_skeleton("default"))
+    for bad in ("floor", float("nan"), [0.0]):
+        with pytest.raises(ParameterError, match="floor must be"):
+            solver.PoseSolver(rig, solver.SolverSettings(floor=bad))  # type: ignore[arg-type]

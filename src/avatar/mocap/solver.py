@@ -63,7 +63,10 @@ class SolverSettings:
     scale: root motion scale, or "auto" (rig leg length / the subject's, measured over
         the first confident frames).
     floor: None (heights as given), "auto" (the lowest ankle seen stands at the rig's rest
-        ankle height) or the floor's height in the input (metres).
+        ankle height), "ground" (the lowest ankle of every frame does: for hips-centred
+        input such as MediaPipe's world landmarks, which carry no height above the floor, so
+        a crouch lowers the hips instead of lifting the feet; a jump stays on the floor) or
+        the floor's height in the input (metres).
     plant_feet: pin feet while a contact is detected.
     """
 
@@ -173,6 +176,11 @@ class PoseSolver:
 
     def __init__(self, rig: RigKeypoints, settings: SolverSettings | None = None):
         self.settings = settings or SolverSettings()
+        floor = self.settings.floor
+        if not (floor is None or floor in ("auto", "ground")
+                or (isinstance(floor, int | float) and math.isfinite(floor))):  # fmt: skip
+            raise ParameterError(f"floor must be None, 'auto', 'ground' or a height in metres, "
+                                 f"got {floor!r}")  # fmt: skip
         self.plan: Plan = make_plan(rig)
         self.rig = rig
         sk = rig.skeleton
@@ -263,6 +271,7 @@ class PoseSolver:
         self._legs: list[float] = []
         self._scale = None if self.settings.scale == "auto" else float(self.settings.scale)
         self._floor = math.inf
+        self._ground = 0.0  # floor="ground": the last frame's lift (kept while ankles are unseen)
         self._time: float | None = None
         self._feet.reset()
 
@@ -400,6 +409,11 @@ class PoseSolver:
         floor = self.settings.floor
         if floor is None:
             return 0.0
+        if floor == "ground":
+            seen = [f.p[k][2] for k in self.plan.ankle_points if k >= 0 and f.ok[k]]
+            if seen:
+                self._ground = self._rest_ankle - min(seen) * s
+            return self._ground
         if floor != "auto":
             return -float(floor) * s
         heights = [f.p[k][2] for k in self.plan.ankle_points if k >= 0 and f.ok[k]]

@@ -8,8 +8,9 @@ and "heavy" models are not in the wheel, hence ``model_complexity=1`` only) and
 
 MediaPipe's world landmarks are metres in camera axes (x right in the image, y down, z away
 from the camera) with the origin between the hips, so the solved motion is the body's
-pose and orientation as the camera sees it, standing on the floor (``floor="auto"``) with
-no travel: a walk across the room becomes a walk on the spot. Landmark ``visibility`` is
+pose and orientation as the camera sees it, its lowest ankle on the floor in every frame
+(``floor="ground"``: a crouch lowers the hips, a jump stays on the floor) with no travel: a
+walk across the room becomes a walk on the spot. Landmark ``visibility`` is
 the solver's confidence (below 0.5: the joint is held and relaxes to rest).
 """
 
@@ -175,9 +176,11 @@ def _landmarks(result, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray, n
 
 
 # The solver's settings for MediaPipe's output: its graph already One-Euro-filters the
-# landmarks, so the solver does not filter again (that would only add latency); heights
-# are put on a floor since world landmarks are centred on the hips.
-VIDEO_SETTINGS = solver.SolverSettings(smoothing=filters.OneEuro.off(), floor="auto")
+# landmarks, so the solver does not filter again (that would only add latency). World
+# landmarks are centred on the hips and say nothing of the body's height above the floor:
+# each frame stands on its lowest ankle ("ground"; with "auto", one floor for the clip,
+# the hips stayed at standing height and a crouch lifted the feet 4 cm off the floor).
+VIDEO_SETTINGS = solver.SolverSettings(smoothing=filters.OneEuro.off(), floor="ground")
 
 
 def solve(pose: VideoPose, skeleton: Skeleton,
