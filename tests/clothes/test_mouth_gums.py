@@ -86,3 +86,24 @@ def test_old_teeth_keep_pink_gums(model):
     gum = skin.teeth_texture()[2, 256].astype(np.float32) / 255
     tinted = skin.srgb_to_linear(gum) * np.asarray(old.base_color[:3])
     assert tinted[0] > 2 * tinted[1]
+
+
+def _luminance(srgb8) -> float:
+    """Linear luminance (Rec. 709) of an sRGB colour (0..255)."""
+    linear = skin.srgb_to_linear(np.asarray(srgb8, np.float32) / 255.0)
+    return float(linear @ np.array([0.2126, 0.7152, 0.0722], np.float32))
+
+
+def test_mouth_lining_and_tongue_are_light_enough_to_read_in_shadow(model):
+    """Inside an open mouth only bounced light reaches the lining: at the old lining
+    colour (luminance 0.16) the palate rendered nearly black (sRGB ~(36, 10, 10)). Wet
+    mucosa is a lighter pink-red than the lips; the tongue a little lighter still."""
+    material = Human({}, model=model).material("body")
+    masks = skin.region_masks(material.base_color_texture.shape[0])
+    lining = material.base_color_texture[masks["inside-mouth"] > 0.9].mean(axis=0)
+    lips = material.base_color_texture[masks["lips"] > 0.9].mean(axis=0)
+    assert _luminance(lining) > 0.2 and _luminance(lining) > _luminance(lips) * 0.9
+    r, g, b = lining
+    assert 1.5 * g < r < 2.2 * g and b < 1.1 * g  # pink-red, not orange, purple or grey
+    tongue = skin.mouth_material("tongue")
+    assert float(np.asarray(tongue.base_color[:3]) @ [0.2126, 0.7152, 0.0722]) > 0.22

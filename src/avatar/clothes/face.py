@@ -93,6 +93,46 @@ def _hops(faces: np.ndarray, count: int, sources: list[int]) -> np.ndarray:
         dist = new
 
 
+def teeth(mesh: Mesh, upper: np.ndarray) -> Mesh:
+    """The teeth part as it renders: UVs over the teeth texture (``teeth_uvs``) and the
+    front teeth seated in a natural bite (``seat_teeth``). mesh, upper: as ``teeth_uvs``."""
+    return seat_teeth(teeth_uvs(mesh, upper), upper)
+
+
+# The front of the arch (incisors, canines) is moved, fading out over the premolars: u is
+# the arch position of ``teeth_uvs`` (0.5 = between the central incisors).
+SEAT_FULL, SEAT_NONE = 0.09, 0.24  # |u - 0.5| up to which the full shift applies / none
+OVERBITE = 0.22  # of the upper row's height: the incisors reach this far below the lower's
+OVERJET_M = (0.0015, 0.0012)  # upper front forward, lower front back (m)
+
+
+def seat_teeth(mesh: Mesh, upper: np.ndarray) -> Mesh:
+    """The teeth with the front of the arch in a natural bite: MakeHuman's helper rows meet
+    edge to edge at the line where the lips close, so with the mouth open the upper lip
+    hides the upper teeth (the mouth reads as a hole over the lower row). In a real mouth
+    the upper incisors hang about 3 mm below the lips' line (what shows under the upper lip
+    when it opens) and overlap the lower ones in front (overbite and overjet). The upper
+    front teeth move down by ``OVERBITE`` of the row's height (~3.5 mm on an adult) and
+    forward, the lower front teeth back, both fading out along the arch to the premolars
+    (the upper edge then rises towards the back, as a smile line does).
+
+    mesh: the teeth part with ``teeth_uvs``' UVs (their u is the arch position); upper:
+    (F,) bool, its faces of the upper row. Returns the mesh with moved vertices.
+    """
+    assert mesh.uvs is not None and mesh.face_uvs is not None, "teeth_uvs first"
+    u = np.zeros(len(mesh.vertices), np.float32)
+    u[mesh.faces.ravel()] = mesh.uvs[mesh.face_uvs.ravel(), 0]
+    front = np.clip((SEAT_NONE - np.abs(u - 0.5)) / (SEAT_NONE - SEAT_FULL), 0, 1)
+    front = front * front * (3 - 2 * front)  # smoothstep: no kink in the arch
+    is_upper = np.zeros(len(mesh.vertices), bool)
+    is_upper[mesh.faces[upper].ravel()] = True
+    incisors = mesh.vertices[is_upper & (front == 1)]
+    height = float(np.ptp(incisors[:, 2]))  # gum to biting edge, ~16 mm on an adult
+    shift = np.where(is_upper[:, None], [0.0, -OVERJET_M[0], -OVERBITE * height],
+                     [0.0, OVERJET_M[1], 0.0])  # fmt: skip
+    return mesh.with_vertices(mesh.vertices + front[:, None] * shift)
+
+
 def teeth_uvs(mesh: Mesh, upper: np.ndarray) -> Mesh:
     """The teeth part (both rows of the base mesh's teeth helpers) with UVs over the teeth
     texture (``looks.skin.teeth_texture``): u along the arch by length from one end (0) to

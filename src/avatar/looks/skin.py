@@ -51,12 +51,12 @@ REGIONS = {
     "inside-mouth": ("mpfb_inside-mouth.jpg", None, 0.2),
 }
 NAIL_SRGB = (236, 205, 198)
-MOUTH_SRGB = (176, 84, 88)  # the mouth's lining: seen in shadow, so not too dark
+MOUTH_SRGB = (198, 110, 114)  # wet mucosa: pinker and lighter than lips (seen in shadow)
 # Islands of other helper geometry that share the body's UV space (u0, v0, u1, v1),
 # measured on base.obj: teeth and tongue get their own colours so they are not skin.
 TEETH_UV = (0.675, 0.87, 0.742, 0.90)
 TONGUE_UV = (0.62, 0.925, 0.652, 0.988)
-TEETH_SRGB, TONGUE_SRGB = (232, 224, 204), (190, 96, 100)
+TEETH_SRGB, TONGUE_SRGB = (232, 224, 204), (208, 118, 122)
 
 # The eyeballs' UV boxes in base.obj (u0, v0, u1, v1); the right eye's layout is the left's
 # mirrored in u. Inside a box, the front pole sits at CORNEA_CENTRE (normalised, left eye).
