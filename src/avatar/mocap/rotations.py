@@ -184,19 +184,19 @@ def kabsch(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]],
            w: Sequence[float]) -> M | None:  # fmt: skip
     """Rotation R minimising sum w_i |R a_i - b_i|^2 (vectors about a fixed centre), or None
     when the points do not fix one (fewer than two independent directions)."""
-    h = [0.0] * 9
+    h0 = h1 = h2 = h3 = h4 = h5 = h6 = h7 = h8 = 0.0  # H = sum w a b^T (locals: fast)
     for (a0, a1, a2), (b0, b1, b2), wi in zip(a, b, w, strict=True):
         a0, a1, a2 = a0 * wi, a1 * wi, a2 * wi
-        h[0] += a0 * b0
-        h[1] += a0 * b1
-        h[2] += a0 * b2
-        h[3] += a1 * b0
-        h[4] += a1 * b1
-        h[5] += a1 * b2
-        h[6] += a2 * b0
-        h[7] += a2 * b1
-        h[8] += a2 * b2
-    u, s, vt = svd3(np.array(h).reshape(3, 3))
+        h0 += a0 * b0
+        h1 += a0 * b1
+        h2 += a0 * b2
+        h3 += a1 * b0
+        h4 += a1 * b1
+        h5 += a1 * b2
+        h6 += a2 * b0
+        h7 += a2 * b1
+        h8 += a2 * b2
+    u, s, vt = svd3(np.array(((h0, h1, h2), (h3, h4, h5), (h6, h7, h8))))
     s0, s1, _ = s.tolist()
     if not s1 >= 1e-9 * max(s0, 1e-300):  # (NaN from a non-finite input too)
         return None

@@ -106,7 +106,8 @@ class _Bone:
     rotation in the anchor's rest frame and step (3,) its rest head in the anchor's frame;
     points: keypoints carried, offsets in this bone's frame; origin: the keypoint at its
     head (-1: none); pole: (mid keypoint, far keypoint, bend axis in this bone's frame) for
-    upper arms and thighs; limit: radians (``limited`` when below a half turn).
+    upper arms and thighs; limit: radians (``limited`` when below a half turn), cos_limit
+    its cosine (a turn bites where (trace - 1) / 2 is below it: no arccos per bone).
     """
 
     anchor: int
@@ -118,6 +119,7 @@ class _Bone:
     pole: tuple[int, int, rot.V] | None
     limit: float
     limited: bool
+    cos_limit: float
 
 
 @dataclass(frozen=True, slots=True)
@@ -217,7 +219,7 @@ class PoseSolver:
         pole = None if st.pole is None else (int(st.pole[0]), int(st.pole[1]), _v(st.pole[2]))
         return _Bone(int(st.anchor), _m(st.rel), _v(st.step), tuple(int(k) for k in st.points),
                      tuple(_v(o) for o in st.offsets), int(st.origin), pole, float(st.limit),
-                     bool(st.limit < math.pi))  # fmt: skip
+                     bool(st.limit < math.pi), math.cos(min(float(st.limit), math.pi)))  # fmt: skip
 
     def _prepare_chain(self, chain, name: str) -> _Chain:
         steps = self.plan.steps
@@ -337,7 +339,8 @@ class PoseSolver:
             local = self._last[i] = rot.power(self._last[i], f.decay) if f.decay else rot.EYE
         else:
             b = self._bone[i]
-            if b.limited and self.settings.limits:
+            if (b.limited and self.settings.limits
+                    and (local[0] + local[4] + local[8] - 1.0) * 0.5 < b.cos_limit):  # fmt: skip
                 local = rot.clamp(local, b.limit)
             self._last[i] = local
             f.solved[i] = True
