@@ -98,3 +98,87 @@ def test_beard_cards_are_sparser_than_scalp_hair():
     half = slice(128, 256)  # the strand cards' rows
     beard_cover = (beard[half, :, 3] > 127).mean()
     assert beard_cover < 0.5 * (scalp[half, :, 3] > 127).mean() and beard_cover > 0.05
+
+
+def _roots(piece) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) root and (N,) length (m) of each strand card of a facial hair piece (cards of
+    2 x 3 vertices: one long side, then the other, root first)."""
+    v = piece.mesh.vertices.reshape(-1, 2, 3, 3).astype(np.float64)
+    mid = v.mean(axis=1)  # (N, 3, 3) the card's centre line
+    return mid[:, 0], np.linalg.norm(np.diff(mid, axis=1), axis=2).sum(axis=1)
+
+
+@pytest.fixture(scope="module")
+def frame():
+    body = authoring_body()
+    return body, face.mouth_frame(body)
+
+
+def test_beard_edge_follows_the_cheek_line_not_a_level_cut(frame):
+    """Seen from the front a beard's upper edge runs from the corner of the mouth up
+    across the cheek to the sideburns; it wanders (no ruler line) and it is not sharp:
+    hair thins out over its last centimetre (sparser and shorter cards)."""
+    body, (centre, mouth, eye_z, _) = frame
+    roots, length = _roots(face.beard(body))
+    turn = face.around(roots, centre)
+    rel_z = roots[:, 2] - mouth[2]
+
+    def top(lo, hi):  # the edge: the highest roots at these directions around the head
+        return np.percentile(rel_z[(turn >= lo) & (turn < hi)], 97)
+
+    corner, cheek, sideburn = top(17, 25), top(50, 60), top(76, 86)
+    assert top(0, 8) > corner + 0.006  # the moustache stands above the mouth's corner
+    assert cheek > corner + 0.015 and sideburn > cheek + 0.015  # rising to the ear
+    # An irregular line: the edge's height against a smooth fit over 30..80 degrees.
+    bins = np.arange(30, 80, 2.5)
+    edge = np.array([top(a, a + 2.5) for a in bins])
+    wander = edge - np.polyval(np.polyfit(bins, edge, 2), bins)
+    assert 0.0015 < wander.std() < 0.006
+
+
+def test_beard_thins_out_over_a_centimetre_at_its_edges(frame):
+    """Hair density falls from full to none over about a centimetre across the cheek line
+    (not a cut), and the cards there are fewer per area and shorter."""
+    body, (centre, mouth, eye_z, _) = frame
+    c = body.vertices[body.skin_faces].mean(axis=1).astype(np.float64)
+    density = face.facial_hair_density(body, "beard", c)
+    turn = face.around(c, centre)
+    cheek = (turn > 35) & (turn < 65) & (c[:, 1] < centre[1] - 0.01)
+    cheek &= (c[:, 2] > mouth[2] - 0.01) & (c[:, 2] < eye_z + 0.02)  # the face, not the body
+    widths = []
+    for lo in range(35, 65, 5):
+        sel = cheek & (turn >= lo) & (turn < lo + 5)
+        z, d = c[sel, 2], density[sel]
+        upper = z[d > 0.9].max()  # the highest full-density skin ...
+        lower = z[(d < 0.1) & (z > upper)].min()  # ... and the lowest bare skin above it
+        widths.append(lower - upper)
+    assert 0.004 < np.median(widths) < 0.016, widths
+    roots, length = _roots(face.beard(body))
+    grow = face.facial_hair_density(body, "beard", roots)
+    quads = body.vertices[body.skin_faces].astype(np.float64)
+    area = 0.5 * np.linalg.norm(np.cross(quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]),
+                                axis=1)  # fmt: skip
+    keep = face.facial_hair_mask(body, "beard")
+    rim_faces, full_faces = keep & (density > 0.05) & (density < 0.5), keep & (density > 0.95)
+    rim, full = (grow > 0.05) & (grow < 0.5), grow > 0.95
+    per_area = rim.sum() / area[rim_faces].sum(), full.sum() / area[full_faces].sum()
+    assert per_area[0] < 0.6 * per_area[1]
+    assert np.median(length[rim]) < 0.75 * np.median(length[full])
+
+
+def test_moustache_tapers_to_the_corners_of_the_mouth(frame):
+    """Full under the nose, narrowing to points at the corners of the mouth: not a block."""
+    body, (_, mouth, *_) = frame
+    roots, length = _roots(face.moustache(body))
+    across = np.abs(roots[:, 0]) / face.MOUSTACHE_HALF_M
+    rel_z = roots[:, 2] - mouth[2]
+
+    def height(lo, hi):
+        z = rel_z[(across >= lo) & (across < hi)]
+        return np.percentile(z, 95) - np.percentile(z, 5)
+
+    middle, outer = height(0.0, 0.2), height(0.8, 0.95)
+    assert middle > 0.01 and outer < 0.55 * middle
+    # ... and its ends hang down towards the corners of the mouth.
+    assert np.median(rel_z[across > 0.75]) < np.median(rel_z[across < 0.3]) - 0.006
+    assert np.abs(roots[:, 0]).max() < 1.15 * face.MOUSTACHE_HALF_M

@@ -180,21 +180,69 @@ def mouth_frame(body: AuthoringBody) -> tuple[np.ndarray, np.ndarray, float, flo
 
 
 # Where a full beard grows, by the direction around the head (degrees from the front): its
-# upper edge above the mouth (m): the moustache under the nose, the cheek line, then up to
-# the sideburns in front of the ears.
-CHEEK_DEG = (0, 12, 20, 35, 55, 70, 80, 86)
-CHEEK_M = (0.018, 0.018, 0.026, 0.03, 0.034, 0.045, 0.05, 0.05)
+# upper edge above the mouth (m). From the moustache under the nose it drops to the corner
+# of the mouth, then the cheek line climbs diagonally across the cheek to the sideburns in
+# front of the ears (seen from the front, a line from the mouth's corner to the ear, not a
+# level cut across the face).
+CHEEK_DEG = (0, 10, 18, 24, 32, 45, 58, 70, 80, 88)
+CHEEK_M = (0.017, 0.014, 0.006, 0.004, 0.012, 0.024, 0.036, 0.05, 0.062, 0.066)
+EDGE_M = 0.01  # the beard thins out over this band at its edges (density 1 -> 0)
+WOBBLE_M = 0.004  # how far the edge wanders off the line (irregular, as hair grows)
+
+
+def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> np.ndarray:
+    """(N,) how densely facial hair grows at ``points`` (N, 3) on the skin, 0..1: 1 well
+    inside, falling off smoothly over ``EDGE_M`` (1 cm) at every edge, along a line that
+    wanders by a few millimetres (a beard's edge is neither straight nor sharp).
+
+    part "beard": chin, jaw, cheeks below the cheek line (``CHEEK_*``), sideburns,
+    moustache and the throat under the chin; "moustache": the upper lip from under the
+    nose, tapering down to points at the corners of the mouth. Lips are left to
+    ``facial_hair_mask``."""
+    centre, mouth, eye_z, chin_z = mouth_frame(body)
+    turn = around(points, centre)
+    rel_z = points[:, 2] - mouth[2]
+    if part == "moustache":
+        # Across the lip (0 middle, 1 corner of the mouth): the upper edge falls from
+        # under the nose towards the corners, the lower one follows the lip line down.
+        across = np.abs(points[:, 0]) / MOUSTACHE_HALF_M
+        top = 0.017 - 0.03 * across**1.4
+        bottom = -0.004 - 0.008 * across**2
+        return (
+            _soft((top - rel_z) / 0.003)
+            * _soft((rel_z - bottom) / 0.002)
+            * _soft((1 - across) / 0.12)
+        )
+    angle = np.radians(turn)
+    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
+    top = np.interp(turn, CHEEK_DEG, CHEEK_M) + wobble
+    under = points[:, 2] - (chin_z - 0.02) + 0.5 * wobble  # the throat, down 2 cm
+    back = np.radians(88 - turn) * 0.08  # m round the head in front of the ear
+    return (
+        _soft((top - rel_z) / EDGE_M)
+        * _soft(under / EDGE_M)
+        * _soft(back / (0.6 * EDGE_M))
+        * (points[:, 2] < eye_z)
+    )
+
+
+MOUSTACHE_HALF_M = 0.028  # from the middle of the lip to the corner of the mouth
+
+
+def _soft(x: np.ndarray) -> np.ndarray:
+    """(N,) a smooth step from 0 (x <= -0.5) to 1 (x >= 0.5): a line with a soft edge,
+    x measured in units of the edge's width, centred on the line."""
+    t = np.clip(x + 0.5, 0, 1)
+    return t * t * (3 - 2 * t)
 
 
 def facial_hair_mask(body: AuthoringBody, part: str) -> np.ndarray:
-    """(F,) bool skin faces where facial hair grows: ``part`` "beard" (a full beard: chin,
-    jaw, cheeks below the cheek line, sideburns, moustache, the throat under the chin down
-    3 cm) or "moustache" (the upper lip under the nose). Lips and the mouth's lining are
-    left bare (MakeHuman's lips and inside-mouth region masks, by the skin's UVs)."""
-    centre, mouth, eye_z, chin_z = mouth_frame(body)
+    """(F,) bool skin faces where facial hair may grow (``facial_hair_density`` above 0 at
+    the face's centre): ``part`` "beard" or "moustache". Lips and the mouth's lining are
+    left bare (MakeHuman's lips and inside-mouth region masks, by the skin's UVs), and
+    only skin looking away from the head's axis (or down, under the chin) grows hair."""
+    centre, mouth, *_ = mouth_frame(body)
     c = body.vertices[body.skin_faces].mean(axis=1)
-    turn = around(c, centre)
-    rel_z = c[:, 2] - mouth[2]
     front = c[:, 1] < centre[1] - 0.01  # ahead of the ears
     bare = _region(body, "lips", 0.25) | _region(body, "inside-mouth", 0.1)
     # Skin facing away from the head's axis, or down (under the chin): not the mouth's
@@ -202,13 +250,10 @@ def facial_hair_mask(body: AuthoringBody, part: str) -> np.ndarray:
     normal = body.skin_normals[body.skin_faces].mean(axis=1)
     radial = (c - centre)[:, :2]
     outside = (np.einsum("fd,fd->f", normal[:, :2], radial) > 0) | (normal[:, 2] < -0.5)
+    grows = facial_hair_density(body, part, c) > 0.02
     if part == "moustache":
-        lip = (np.abs(c[:, 0]) < 0.025) & (rel_z > -0.002) & (rel_z < 0.018)
-        return lip & front & ~bare & outside & (c[:, 1] < mouth[1] - 0.01)
-    top = np.interp(turn, CHEEK_DEG, CHEEK_M)
-    # Under the chin to the top of the throat, not down the neck.
-    beard = (rel_z < top) & (c[:, 2] > chin_z - 0.018) & (turn < 88)
-    return beard & front & ~bare & outside & (c[:, 2] < eye_z)
+        grows &= c[:, 1] < mouth[1] - 0.01
+    return grows & front & ~bare & outside
 
 
 def _region(body: AuthoringBody, name: str, level: float) -> np.ndarray:
@@ -238,31 +283,42 @@ def _beard_flow(centre: np.ndarray):
     return flow
 
 
-def beard(body: AuthoringBody, count: int = 3200, length=(0.008, 0.015)) -> Piece:
-    """A short full beard: narrow strand cards rooted over ``facial_hair_mask(body,
-    "beard")``, combed down the face, about a centimetre long, lying close to the skin and
-    thinning out at its edges. The hair above the mouth (the moustache) and the rest are
-    bound apart: one rides the upper lip, the other the jaw, so opening the mouth parts
-    them."""
+def beard(body: AuthoringBody, count: int = 3600, length=(0.007, 0.013)) -> Piece:
+    """A short full beard: narrow strand cards rooted where ``facial_hair_density(body,
+    "beard", ...)`` lets them grow, combed down the face, about a centimetre long, lying
+    close to the skin, thinning out (sparser, shorter, flatter) over the last centimetre to
+    its edges. The hair above the mouth (the moustache) and the rest are bound apart: one
+    rides the upper lip, the other the jaw, so opening the mouth parts them."""
     centre, mouth, *_ = mouth_frame(body)
     keep = facial_hair_mask(body, "beard")
     c = body.vertices[body.skin_faces].mean(axis=1)
     upper = (c[:, 2] > mouth[2] - 0.004) & (np.abs(c[:, 0]) < 0.035)
     share = (keep & upper).sum() / keep.sum()
     flow, lift = _beard_flow(centre), (0.001, 0.003)
+
+    def density(points: np.ndarray) -> np.ndarray:
+        return facial_hair_density(body, "beard", points)
+
     return join([
-        cards_on(body, keep & upper, flow, int(count * share), length, 0.0035, lift, fade=0.006),
-        cards_on(body, keep & ~upper, flow, count - int(count * share), length, 0.0035, lift,
-                 seed=2, fade=0.008),
+        cards_on(body, keep & upper, flow, int(count * share), length, 0.0032, lift,
+                 density=density),
+        cards_on(body, keep & ~upper, flow, count - int(count * share), length, 0.0032, lift,
+                 seed=2, density=density),
     ])  # fmt: skip
 
 
-def moustache(body: AuthoringBody, count: int = 420) -> Piece:
-    """A moustache: narrow strand cards over the upper lip, combed down and out over it."""
+def moustache(body: AuthoringBody, count: int = 480) -> Piece:
+    """A moustache: narrow strand cards over the upper lip, combed down and out over it,
+    full under the nose and tapering to points at the corners of the mouth
+    (``facial_hair_density(body, "moustache", ...)``)."""
     centre, *_ = mouth_frame(body)
     keep = facial_hair_mask(body, "moustache")
-    return cards_on(body, keep, _beard_flow(centre), count, (0.008, 0.013), 0.0035,
-                    (0.001, 0.0025), seed=1, fade=0.005)  # fmt: skip
+
+    def density(points: np.ndarray) -> np.ndarray:
+        return facial_hair_density(body, "moustache", points)
+
+    return cards_on(body, keep, _beard_flow(centre), count, (0.008, 0.013), 0.0032,
+                    (0.001, 0.0025), seed=1, density=density)  # fmt: skip
 
 
 STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble texture covers

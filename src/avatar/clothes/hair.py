@@ -14,7 +14,6 @@ v in [0, 0.5] strand cards from root (v = 0.5) to tip (v = 0), alpha thinning at
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import (
@@ -209,26 +208,26 @@ def cards_on(
     lift=(0.0015, 0.004),
     segments: int = 2,
     seed: int = 0,
-    fade: float = 0.0,
+    density=None,
 ) -> Piece:
     """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
     ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
     rising from the skin to a random lift in ``lift`` (m) over their length (beards,
     moustaches). UVs as ``grow_cards``'. The cards are bound to the chosen faces only, so
-    a moustache hanging over the lips rides the upper lip, not the jaw below it. Within
-    ``fade`` m of the region's edge the cards thin out and get shorter and flatter.
-    (At most ``count`` cards: roots are drawn twice over, then thinned at the edges.)"""
+    a moustache hanging over the lips rides the upper lip, not the jaw below it.
+
+    density: points (N, 3) -> (N,) 0..1, how thickly hair grows there (None: 1). A root
+    survives with that probability, and where it is low (the region's soft edges) the
+    cards are also shorter and lie flatter, so the hair thins out instead of ending at a
+    line. (At most ``count`` cards: roots are drawn three times over, then thinned.)"""
     rng = np.random.default_rng([seed, count])
-    roots = _scatter(body, keep, 2 * count, rng)
-    # Thinner, shorter and flatter towards the region's edges (no hard line where it ends).
-    edge = body.vertices[body.skin_faces[~keep]].mean(axis=1)
-    inward = np.clip(cKDTree(edge).query(roots)[0] / fade, 0, 1) if fade > 0 else np.ones(
-        len(roots))  # fmt: skip
-    pick = np.flatnonzero(rng.uniform(size=len(roots)) < 0.15 + 0.85 * inward)[:count]
-    roots, inward = roots[pick], inward[pick]
+    roots = _scatter(body, keep, 3 * count, rng)
+    grow = np.ones(len(roots)) if density is None else np.asarray(density(roots), float)
+    pick = np.flatnonzero(rng.uniform(size=len(roots)) < grow)[:count]
+    roots, grow = roots[pick], grow[pick]
     count = len(roots)
-    size = rng.uniform(length[0], length[1], count) * (0.5 + 0.5 * inward)
-    top = rng.uniform(lift[0], lift[1], count) * (0.4 + 0.6 * inward)
+    size = rng.uniform(length[0], length[1], count) * (0.35 + 0.65 * grow)
+    top = rng.uniform(lift[0], lift[1], count) * (0.4 + 0.6 * grow)
     rows, point = [roots], roots
     for k in range(1, segments + 1):
         step = _tangent(body, point, flow(point))
