@@ -415,29 +415,38 @@ def skin_offset(body: AuthoringBody, points: np.ndarray, k: int = 6,
 
 def sit_on_hips(body: AuthoringBody, points: np.ndarray, ease: float, hip_z: float,
                 fall: float = 0.12, under: np.ndarray | None = None,
-                gap: float = 0.004) -> np.ndarray:  # fmt: skip
+                gap: float = 0.004, edge_gap: float = 0.0025,
+                edge: float = 0.025) -> np.ndarray:  # fmt: skip
     """(N, 3) skirt points with everything above ``hip_z`` laid ``ease`` m off the skin
     (the waist and hips carry a skirt: it sits on them), easing over ``fall`` m below
     ``hip_z`` back to the points' own, flared positions, so the flare starts below the
     hip instead of standing out from the waist (a helper skirt stands 1.5-3 cm off the
     hips of slim and heavy bodies, a ridge and pleats round the hips). ``under``: (M, 3)
     points of a layer the skirt lies over (a dress's bodice): the skirt keeps ``gap`` m
-    outside the nearest of them."""
+    outside the nearest of them, closing to ``edge_gap`` m over its top ``edge`` m, so
+    its top edge meets the layer under it as a seam does, not as a ledge."""
     out = points.astype(np.float64).copy()
     t = np.clip((hip_z - out[:, 2]) / fall, 0, 1)
     w = 1 - t * t * (3 - 2 * t)  # 1 above the hip, smoothly 0 a ``fall`` below it
     moving = w > 0
     floor = np.zeros(int(moving.sum()))
+    hug_top = np.full(int(moving.sum()), np.inf)
     if under is not None and len(under):
         from scipy.spatial import cKDTree
 
         under_off, _ = skin_offset(body, under.astype(np.float64))
         reach, nearest = cKDTree(under).query(out[moving])
         over = (reach < 0.06) & (out[moving, 2] > under[:, 2].min() - 0.01)
-        floor = np.where(over, under_off[nearest] + gap, 0.0)
+        s = np.clip((out[moving, 2] - (out[:, 2].max() - edge)) / edge, 0, 1)
+        here = gap + (edge_gap - gap) * s * s * (3 - 2 * s)
+        floor = np.where(over, under_off[nearest] + here, 0.0)
+        # At the edge the skirt closes onto the layer under it, hug or not.
+        closing = over & (s > 0)
+        hug_top = np.where(closing, floor, np.inf)
     for _ in range(2):  # a second pass corrects the first's error on curved skin
         off, normal = skin_offset(body, out[moving])
-        target = np.maximum(w[moving] * ease + (1 - w[moving]) * off, floor)
+        target = np.maximum(np.minimum(w[moving] * ease + (1 - w[moving]) * off, hug_top),
+                            floor)  # fmt: skip
         out[moving] += (target - off)[:, None] * normal
     return out
 
