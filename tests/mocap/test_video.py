@@ -111,6 +111,9 @@ def test_rendered_walk_is_recovered_from_video(fixtures, model, tmp_path, capsys
     assert result.pa_mpjpe < 90.0, result.summary()
     assert result.mpjpe < 120.0, result.summary()
     assert max(result.bones.values()) < 35.0, result.bones
+    # smoothed over time without lag: no jerkier than twice the clip (2.8x unsmoothed on
+    # the 360-frame forward jumps)
+    assert result.jerk[0] < 2.0 * result.jerk[1], result.summary()
     # the comparison sees a wrong turn: the clip turned a quarter more is far off
     quarter = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     axes = groundtruth.camera_axes(camera)

@@ -38,20 +38,24 @@ BONES = {  # COCO segments whose direction error is reported
 @dataclass(frozen=True)
 class Comparison:
     """mpjpe, pa_mpjpe: mm, mean over frames and the 17 joints; per_frame: (T,) PA-MPJPE mm;
-    bones: segment name -> mean direction error in degrees; frames: frames compared."""
+    bones: segment name -> mean direction error in degrees; frames: frames compared;
+    jerk: (solved, truth) mean joint acceleration, mm per frame^2 (jitter shows as the
+    solved motion's being higher than the clip's)."""
 
     mpjpe: float
     pa_mpjpe: float
     per_frame: np.ndarray
     bones: dict[str, float]
     frames: int
+    jerk: tuple[float, float] = (float("nan"), float("nan"))
 
     def summary(self) -> str:
         worst = max(self.bones, key=self.bones.__getitem__)
         mean = float(np.mean(list(self.bones.values())))
         return (f"{self.frames} frames: MPJPE {self.mpjpe:.1f} mm, PA-MPJPE "
                 f"{self.pa_mpjpe:.1f} mm, bone direction {mean:.1f} deg mean "
-                f"(worst {worst} {self.bones[worst]:.1f} deg)")  # fmt: skip
+                f"(worst {worst} {self.bones[worst]:.1f} deg), acceleration {self.jerk[0]:.1f} "
+                f"mm/frame^2 (clip {self.jerk[1]:.1f})")  # fmt: skip
 
 
 def in_place(skeleton: Skeleton, animation: Animation) -> Animation:
@@ -94,7 +98,15 @@ def compare(skeleton: Skeleton, truth: Animation, solved: Animation,
         da, db = a[:, j] - a[:, i], b[:, j] - b[:, i]
         cos = (da * db).sum(-1) / (np.linalg.norm(da, axis=-1) * np.linalg.norm(db, axis=-1))
         bones[name] = float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).mean())
-    return Comparison(mpjpe, float(per_frame.mean()), per_frame, bones, count)
+    return Comparison(mpjpe, float(per_frame.mean()), per_frame, bones, count,
+                      (_acceleration(b), _acceleration(a)))  # fmt: skip
+
+
+def _acceleration(points: np.ndarray) -> float:
+    """Mean length of the joints' second difference over frames (T, K, 3), mm/frame^2."""
+    if len(points) < 3:
+        return float("nan")
+    return float(np.linalg.norm(np.diff(points, 2, axis=0), axis=-1).mean() * 1000)
 
 
 def _procrustes_error(truth: np.ndarray, got: np.ndarray) -> float:

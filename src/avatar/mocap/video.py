@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar.errors import AvatarError, FormatError
-from avatar.mocap import filters, keypoints, solver
+from avatar.mocap import filters, keypoints, solver, temporal
 from avatar.rig.skeleton import Animation, Skeleton
 
 log = logging.getLogger(__name__)
@@ -176,20 +176,23 @@ def _landmarks(result, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray, n
 
 
 # The solver's settings for MediaPipe's output: its graph already One-Euro-filters the
-# landmarks, so the solver does not filter again (that would only add latency). World
+# landmarks and ``solve`` smooths them over time without lag, so the solver does not
+# filter again (that would only add latency). World
 # landmarks are centred on the hips and say nothing of the body's height above the floor:
 # each frame stands on its lowest ankle ("ground"; with "auto", one floor for the clip,
 # the hips stayed at standing height and a crouch lifted the feet 4 cm off the floor).
 VIDEO_SETTINGS = solver.SolverSettings(smoothing=filters.OneEuro.off(), floor="ground")
 
 
-def solve(pose: VideoPose, skeleton: Skeleton,
-          settings: solver.SolverSettings | None = None) -> Animation:  # fmt: skip
+def solve(pose: VideoPose, skeleton: Skeleton, settings: solver.SolverSettings | None = None,
+          smooth: float = temporal.SIGMA) -> Animation:  # fmt: skip
     """The video's motion on a rig: an Animation at the video's frame rate (frames with no
-    person hold the last pose and relax to rest)."""
+    person hold the last pose and relax to rest). The landmarks are first smoothed over
+    time without lag (``temporal.smooth``, sigma ``smooth`` seconds; 0: not)."""
     if not len(pose.points):
         raise AvatarError("the video has no frames")
     if not pose.found.any():
         raise AvatarError("MediaPipe found no person in the video")
     rig = keypoints.bind("mediapipe33", skeleton)
-    return solver.solve(rig, pose.points, pose.confidence, pose.fps, settings or VIDEO_SETTINGS)
+    points = temporal.smooth(pose.points, pose.confidence, pose.fps, smooth)
+    return solver.solve(rig, points, pose.confidence, pose.fps, settings or VIDEO_SETTINGS)
