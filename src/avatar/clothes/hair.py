@@ -164,11 +164,11 @@ def flow_tied(tie_offset=(0.0, 0.07, 0.0)):
 def grow_cards(
     body: AuthoringBody,
     flow,
-    count: int = 380,
-    length=(0.035, 0.055),
-    width: float = 0.02,
-    lift=(0.006, 0.022),
-    segments: int = 3,
+    count: int = 1500,
+    length=(0.03, 0.05),
+    width: float = 0.008,
+    lift=(0.004, 0.014),
+    segments: int = 4,
     seed: int = 0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
@@ -177,6 +177,11 @@ def grow_cards(
     ``length`` metres along the flow, so higher cards cover lower ones the way layered hair
     does; ``lift`` (low, high) grows from the hairline (low) to the top of the head (high).
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
+
+    The defaults are a short haircut (``hair-short``): many narrow cards (8 mm, a few
+    dozen hairs each) lying within 1.5 cm of the scalp. Fewer, wider, higher cards (the
+    old 380 x 2 cm up to 2.2 cm off the scalp) read as spiky clumps: each card's straight
+    edge and tip show against the light and in the silhouette.
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
