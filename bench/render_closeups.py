@@ -1,5 +1,5 @@
 """Render close-ups of heads or feet (docs/images/closeup_*.png) to check skin, mouth,
-brows, hair and shoes by eye.
+brows, hair, beards and shoes by eye.
 
     python bench/render_closeups.py heads [--samples 12] [--out docs/images] [--views front,back]
     python bench/render_closeups.py feet
@@ -7,7 +7,8 @@ brows, hair and shoes by eye.
     python bench/render_closeups.py tops [--walk]                             # cap, hood, dress
 
 Needs the pip ``bpy`` module. Heads: front, three-quarter and back, the mouth open
-(``expression/jawOpen``) on two of them so teeth and tongue show. Feet: five bodies' shoes.
+(``expression/jawOpen``) on three of them so teeth and tongue show, a beard and a
+moustache. Feet: five bodies' shoes.
 Small and few renders: Cycles on the CPU at low samples.
 """
 
@@ -28,7 +29,8 @@ SETS["heads"] = [  # (parameters, garments): child, young woman, muscular man, o
     ({"gender": 0.0, "age": 0.45, "expression/jawOpen": 0.7}, ("eyebrows-blond", "eyelashes", "hair-long")),  # noqa: E501
     ({"gender": 1.0, "age": 0.5, "muscle": 0.9, "african": 1.0, "asian": 0.0, "caucasian": 0.0}, ("eyebrows-black", "eyelashes", "hair-buzz")),  # noqa: E501
     ({"gender": 0.0, "age": 0.9, "asian": 1.0, "african": 0.0, "caucasian": 0.0, "expression/jawOpen": 0.6}, ("eyebrows", "eyelashes", "hair-bun")),  # noqa: E501
-    ({"gender": 1.0, "age": 1.0}, ("eyebrows", "eyelashes")),
+    ({"gender": 1.0, "age": 1.0}, ("eyebrows", "eyelashes", "beard-short")),
+    ({"gender": 1.0, "age": 0.6, "expression/jawOpen": 0.8}, ("eyebrows", "eyelashes", "hair-short", "moustache")),  # noqa: E501
 ]  # fmt: skip
 SETS["feet"] = [
     ({"gender": 0.3, "age": 0.12}, ("socks", "shoes", "trousers")),
