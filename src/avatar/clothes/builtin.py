@@ -254,7 +254,7 @@ def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
     thickness. Modelled as a grid over the back (the helper mesh is too coarse to cut a
     point from), each point the back's surface plus the hood's puff, then bound to it."""
     m = body.marks
-    low, high = m.neck[2] - 0.24, m.neck[2] + 0.005  # its top tucked under the collar
+    low, high = m.neck[2] - 0.24, m.neck[2] - 0.005  # its top tucked under the collar
 
     def half_width(d):
         """m either side of the spine at depth d (0 at the neck, 1 at the tip)."""
@@ -422,15 +422,18 @@ def _hood_collar(body: AuthoringBody, top_mesh: Mesh) -> Piece:
         front = np.clip(1 - np.abs(a) / np.radians(70), 0, 1)  # 0 at the sides, 1 in front
         direction = np.stack([np.sin(a), -np.cos(a), np.zeros_like(a)], -1)
         path = np.concatenate([centre, [0.0]]) + (r + 0.012)[:, None] * direction
-        rest = z + 0.008  # on the neckline, its lower edge over the hoodie's
+        # Level round the back and sides at the back's neckline (a neckline rises over
+        # the trapezius; a roll lying on it does not), its lower edge over the hoodie's.
+        level = float(np.interp(np.pi, NECK_ANGLES, height)) + 0.014
+        rest = level * (1 - front) + (z + 0.008) * front
         path[:, 2] = rest + (m.neck[2] - COLLAR_V - rest) * front**1.6
         # The front ends run past the middle: the left half crosses over the right.
         path[:, 0] -= side * 0.02 * front**3
-        lift = 0.003 + (0.009 if side > 0 else 0.0) * front**2
+        lift = 0.003 + (0.007 if side > 0 else 0.0) * front**2
         radii = np.stack([0.0085 + 0.002 * (1 - front), 0.013 - 0.004 * front**2], -1)
         # The roll's centre clears the skin by its own size (over the hoodie and, at the
         # back, over the bag's top); the per-vertex push below only mops up.
-        gap = 0.012 + 0.004 * (1 - front) + radii.max(axis=1) + lift
+        gap = 0.011 + 0.005 * (1 - front) + radii.max(axis=1) + lift
         for _ in range(3):  # pushed clear, then smoothed along (no horns over the trapezius)
             path = shoes._at_least(body, path, gap)
             for _ in range(4):
