@@ -22,10 +22,10 @@ def test_jitter_goes_and_steady_motion_keeps_its_place():
     noisy = clean + np.random.default_rng(0).normal(0.0, 0.01, clean.shape)
     got = temporal.smooth(noisy, None, fps)
     assert _jerk(got) < 0.25 * _jerk(noisy)
-    inner = slice(5, -5)  # away from the clip's ends (the kernel is cut there)
-    assert np.abs(got[inner] - clean[inner]).mean() < 0.5 * np.abs(noisy - clean).mean()
+    inner = slice(5, -5)  # away from the clip's ends (the window shrinks there)
+    assert np.abs(got[inner] - clean[inner]).mean() < 0.6 * np.abs(noisy - clean).mean()
     steady = temporal.smooth(clean, None, fps)
-    np.testing.assert_allclose(steady[inner, 0], clean[inner, 0], atol=1e-12)  # no lag
+    np.testing.assert_allclose(steady[:, 0], clean[:, 0], atol=1e-12)  # no lag, ends too
     np.testing.assert_allclose(steady[inner, 1], clean[inner, 1], atol=2e-3)  # 0.1 m swing
 
 
@@ -50,3 +50,13 @@ def test_zero_sigma_and_bad_arguments():
     for sigma, fps in ((-1.0, 30.0), (float("nan"), 30.0), (0.05, 0.0)):
         with pytest.raises(ParameterError, match="sigma"):
             temporal.smooth(points, None, fps, sigma=sigma)
+
+
+def test_a_sudden_start_is_not_pulled_towards_later_frames():
+    """The first frame keeps its pose (a clip starting in a T-pose whose arms drop at once:
+    a one-sided window moved the first frame's arms half-way down)."""
+    points = np.zeros((30, 1, 3))
+    points[0, 0, 2] = 1.0  # frame 0 up, every later frame down
+    got = temporal.smooth(points, None, 30.0)
+    assert got[0, 0, 2] == 1.0
+    assert got[1:, 0, 2].max() < 0.5

@@ -31,9 +31,14 @@ plain float arithmetic (``rotations``: 9-tuple matrices), going to numpy only fo
 filter, the SVD of each rigid fit and the final matrix -> quaternion conversion. Single bones
 are solved in their anchor's rest frame (the fitted turn conjugated: one product fewer);
 chain refinements move only the fitted keypoints (Rodrigues on vectors, no posed frames).
-About 0.5-0.9 ms a frame on a shared 2-core machine, ~4x the numpy-per-level solver it
-replaced, with the same results (``tests/mocap/test_solver_regression.py``: within 1e-6 rad);
-``bench/mocap.py`` times it against forward kinematics of the rig and that solver.
+The spine is solved twice (before and after the clavicles hanging on it): the second pass
+reuses the first's initial fit, and the first places only the bone the clavicles hang on.
+COCO-17 0.55-0.85 ms a frame, MediaPipe-33 0.70-1.2 ms, on a shared 2-core machine at load
+12-16 (0.22-0.25 x forward kinematics of the rig; 1.3x the revision before these changes,
+~5x the numpy-per-level solver before that), with the same results
+(``tests/mocap/test_solver_regression.py``: within 1e-6 rad); ``bench/mocap.py`` times it
+against forward kinematics of the rig and the previous revision. What is left is mostly
+Python's per-operation cost and ~11-15 LAPACK SVDs of 3x3 rigid fits (5-10 us each).
 """
 
 from __future__ import annotations

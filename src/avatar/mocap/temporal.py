@@ -7,14 +7,26 @@ without delaying anything (a joint moving at constant speed is left where it is)
 
 Missing keypoints (NaN, or confidence below the threshold) take no part: each output is the
 weighted mean of the seen samples within three sigmas (normalised convolution), and a
-keypoint seen in none of them stays missing. Confidence is left as it was.
+keypoint seen in none of them stays missing. Near the clip's ends the window shrinks to
+what both sides have (the first and last frames are kept as they are). Confidence is left
+as it was.
 
-Measured on the rendered forward-jumps ground truth (``bench/mocap_video.py``, 360 frames
-at 30 fps): MediaPipe's landmarks, already One-Euro-filtered by its graph, still moved
-2.8x as jerkily as the clip (mean joint acceleration 25.6 vs 9.0 mm/frame^2); sigma 50 ms
-brought that to 8.8 and lowered MPJPE 118.0 -> 116.9 mm and PA-MPJPE 54.4 -> 54.1 mm, where
-a causal One Euro pass (default strength) left 13.6 and raised both (its lag). 50 ms was
-chosen on that clip (about 33 and 67 ms gave 12.2 and 7.0 mm/frame^2).
+Measured on rendered ground truth (``bench/mocap_video.py``, 30 fps), MediaPipe's landmarks,
+already One-Euro-filtered by its graph, against the clip (mean joint acceleration, jitter;
+MPJPE / PA-MPJPE in mm):
+
+    clip                          sigma   acceleration mm/frame^2   MPJPE   PA-MPJPE
+    forward jumps, 360 frames     0       25.6 (clip 9.0)           118.0   54.4
+                                  33 ms   12.4                      117.3   54.1
+                                  50 ms    9.0                      116.9   53.9
+    walk 02_01, 60 frames         0       17.2 (clip 9.0)            72.1   58.3
+                                  33 ms    9.1                       71.6   58.7
+                                  50 ms    7.5                       71.3   59.0
+
+A causal One Euro pass (default strength) on the jumps left 13.6 mm/frame^2 and raised both
+errors (its lag). One frame at 30 fps (33 ms) is the default: it brings the walk to the
+clip's own smoothness, where 50 ms smooths it more than the clip moves (its price there:
+0.4 mm of PA-MPJPE).
 """
 
 from __future__ import annotations
@@ -23,7 +35,7 @@ import numpy as np
 
 from avatar.errors import ParameterError
 
-SIGMA = 0.05  # seconds
+SIGMA = 1.0 / 30.0  # seconds: one frame of a 30 fps video
 
 
 def smooth(points: np.ndarray, confidence: np.ndarray | None, fps: float,
@@ -50,8 +62,10 @@ def smooth(points: np.ndarray, confidence: np.ndarray | None, fps: float,
     summed = np.zeros_like(values)
     count = len(points)
     for offset, k in zip(range(-radius, radius + 1), kernel, strict=True):
-        # frame t takes k * sample (t + offset), where that frame exists
-        lo, hi = max(0, -offset), min(count, count - offset)
+        # frame t takes k * sample (t + offset) where its window reaches as far on the
+        # other side: near the ends the window shrinks symmetrically (a one-sided one would
+        # pull the first frames towards the later ones: a T-pose start lost its arms)
+        lo, hi = abs(offset), count - abs(offset)
         if lo >= hi:
             continue
         total[lo:hi] += k * weight[lo + offset : hi + offset]
