@@ -9,8 +9,10 @@
    interleaved with the solver: forward kinematics of the same rig for the same frames
    (``world_pose``, one frame per call: a fixed numpy workload), and the reference solver:
    ``avatar.mocap`` (rotations, filters, feet, plan, solver) as it was at git revision
-   --reference (default: the last commit before the plain-float rewrite), imported under
-   another name.
+   --reference (default 9d87694: before the spine-pass reuse and the VMC decoder), imported
+   under another name. Then the VMC receive path alone (datagram -> frame -> rotations on
+   the rig, CPU ms per frame), against ``avatar.mocap.vmc``/``unity`` at that revision
+   (python-osc's parser, a quaternion product of 36 numpy calls per tree level).
 2. End to end on loopback (goal < 16.7 ms, one 60 Hz frame), wall time from the send to
    the posed skin mesh (13,380 vertices, linear blend skinning) in this process:
    (a) VMC: bundles built and sent with python-osc alone (not Avatar's sender) -> Avatar's
