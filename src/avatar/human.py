@@ -437,10 +437,12 @@ class Human:
     @cached_property
     def outfit(self) -> Outfit:
         """The recipe's garments fitted on this body (``avatar.clothes.outfit.Outfit``),
-        every vertex outside the body (``exact``: this is what exports and renders use)."""
+        every vertex outside the body (``exact``: this is what exports and renders use);
+        brows and facial hair follow the hair worn and grey with age."""
+        age = (self.model.defaults() | self.recipe.params)["age"]
         return library.dress(self.body, list(self.recipe.clothes), exact=True,
                              folders=self.recipe.folders,
-                             options=self.recipe.garment_options)  # fmt: skip
+                             options=self.recipe.garment_options, age=age)  # fmt: skip
 
     def dressed(self, *garments: str) -> Human:
         """A copy of this human also wearing ``garments`` (library names or .mhclo paths).

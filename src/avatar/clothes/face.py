@@ -11,6 +11,7 @@ from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, single_references
 from avatar.clothes.hair import around, cards_on, head_frame, per_corner
 from avatar.geometry.shell import boundary_edges
+from avatar.looks.facial_hair import CHEEK_DEG, CHEEK_M, EDGE_M, WOBBLE_M  # noqa: F401
 from avatar.mesh import Mesh
 
 
@@ -179,17 +180,6 @@ def mouth_frame(body: AuthoringBody) -> tuple[np.ndarray, np.ndarray, float, flo
     return centre, mouth, eye_z, float(head[:, 2].min())
 
 
-# Where a full beard grows, by the direction around the head (degrees from the front): its
-# upper edge above the mouth (m). From the moustache under the nose it drops to the corner
-# of the mouth, then the cheek line climbs diagonally across the cheek to the sideburns in
-# front of the ears (seen from the front, a line from the mouth's corner to the ear, not a
-# level cut across the face).
-CHEEK_DEG = (0, 10, 18, 24, 32, 45, 58, 70, 80, 88)
-CHEEK_M = (0.017, 0.014, 0.006, 0.004, 0.012, 0.024, 0.036, 0.05, 0.062, 0.066)
-EDGE_M = 0.01  # the beard thins out over this band at its edges (density 1 -> 0)
-WOBBLE_M = 0.004  # how far the edge wanders off the line (irregular, as hair grows)
-
-
 def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> np.ndarray:
     """(N,) how densely facial hair grows at ``points`` (N, 3) on the skin, 0..1: 1 well
     inside, falling off smoothly over ``EDGE_M`` (1 cm) at every edge, along a line that
@@ -321,20 +311,28 @@ def moustache(body: AuthoringBody, count: int = 480) -> Piece:
                     (0.001, 0.0025), seed=1, density=density)  # fmt: skip
 
 
-STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble texture covers
+STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble's stubs covers
 
 
 def stubble(body: AuthoringBody) -> Piece:
-    """Stubble: the beard's skin lifted half a millimetre, with UVs tiling the stubble
-    texture (``looks.facial_hair.stubble_material``) every ``STUBBLE_TILE`` m, projected
-    from the front and the sides so the short hairs keep their size round the jaw."""
+    """Stubble: the beard's skin lifted half a millimetre, with UVs over the stubble atlas
+    (``looks.facial_hair.stubble_material``): u the arc round the face, v the height from
+    the mouth, in metres over ``facial_hair.STUBBLE_SPAN_U`` / ``STUBBLE_V``, so the atlas's
+    density fades out at the beard's cheek line and sideburns; below the mouth v is scaled
+    so the throat's edge (2 cm under the chin) lands on ``STUBBLE_THROAT_M``."""
+    from avatar.looks import facial_hair as fh
+
     faces = body.skin_faces
     mesh = cut(body, faces, facial_hair_mask(body, "beard"), 0.0005, relax=4)
-    centre, *_ = mouth_frame(body)
+    centre, mouth, _, chin_z = mouth_frame(body)
     p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, 4, 3)
     rel = p - centre
     angle = np.arctan2(rel[..., 0], -rel[..., 1])  # round the head
-    u = angle * 0.075 / STUBBLE_TILE  # ~7.5 cm radius: arc length in tiles
-    v = rel[..., 2] / STUBBLE_TILE
+    arc = angle * fh.ARC_RADIUS_M
+    rel_z = p[..., 2] - mouth[2]
+    throat = (chin_z - 0.02) - mouth[2]  # < 0
+    rel_z = np.where(rel_z < 0, rel_z * (fh.STUBBLE_THROAT_M / throat), rel_z)
+    u = (arc / fh.STUBBLE_SPAN_U + 1) / 2
+    v = (rel_z - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])
     return bound(body, per_corner(mesh, np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)),
                  faces)  # fmt: skip

@@ -28,6 +28,7 @@ from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.clothes.scan import LibraryEntry, scan
 from avatar.clothes.scan import entry as scan_entry
 from avatar.errors import AvatarError, unknown_name
+from avatar.material import Material
 from avatar.part import MeshPart
 
 ENV_PATH = "AVATAR_CLOTHES_PATH"
@@ -218,16 +219,76 @@ def dress(
     exact: bool = False,
     folders: Iterable[str | os.PathLike[str]] = (),
     options: Mapping[str, Mapping[str, object]] | None = None,
+    age: float | None = None,
 ) -> Outfit:
     """Fit garments (Garment records, or names/paths: ``load_garment``) on a shaped body
-    (``Human.body``); see ``fitting.dress``. options: {entry: a built-in's variant}."""
+    (``Human.body``); see ``fitting.dress``. options: {entry: a built-in's variant}.
+    age: the wearer's MakeHuman age; given, the built-in brows and facial hair follow the
+    wearer (``wearer_looks``): the built-in scalp hair's colour, greying with age."""
     options = options or {}
     loaded = [
         g if isinstance(g, Garment)
         else load_garment(g, folders, model=body.model, options=options.get(str(g)))
         for g in garments
     ]
+    if age is not None:
+        loaded = wearer_looks(loaded, [str(g) if not isinstance(g, Garment) else g.name
+                                       for g in garments], options, age)  # fmt: skip
     return fitting.dress(body, loaded, exact)
+
+
+# Built-ins that follow their wearer's hair colour and age, and how (``for_wearer``'s kind);
+# the named brow colours (eyebrows-blond, -black) keep their colour but still grey.
+FOLLOWS_HAIR = {"eyebrows": "brows", "beard-short": "cards", "moustache": "cards",
+                "stubble": "stubble"}  # fmt: skip
+KEEPS_COLOUR = {"eyebrows-blond": "brows", "eyebrows-black": "brows"}
+
+
+def wearer_looks(
+    loaded: list[Garment], names: list[str], options: Mapping[str, Mapping[str, object]],
+    age: float,
+) -> list[Garment]:
+    """``loaded`` with the built-in brows and facial hair recoloured for the wearer: the
+    colour of the built-in scalp hair worn (its variant's, else its own) unless the item
+    has a colour option of its own, greying with ``age`` (``facial_hair.for_wearer``)."""
+    hair = None
+    for name in names:
+        spec = builtin.BY_NAME.get(name)
+        if spec is not None and spec.category == "hair":
+            hair = str(options.get(name, {}).get("colour", spec.colour))
+    out = []
+    for garment, name in zip(loaded, names, strict=True):
+        kind = FOLLOWS_HAIR.get(name) or KEEPS_COLOUR.get(name)
+        if kind is None:
+            out.append(garment)
+            continue
+        own = options.get(name, {}).get("colour")
+        colour = None if (own or name in KEEPS_COLOUR) else hair
+        look = _wearer_material(garment, kind, round(float(age), 2), colour)
+        out.append(replace(garment, material=look))
+    return out
+
+
+_WEARER: dict[tuple, tuple[Material, Material]] = {}
+
+
+def _wearer_material(
+    garment: Garment, kind: str, age: float, colour: str | None
+) -> Material | None:
+    """``facial_hair.for_wearer`` of a garment's material, remembered (a few dozen)."""
+    from avatar.looks import facial_hair
+
+    if garment.material is None:
+        return None
+    key = (id(garment.material), kind, age, colour)
+    hit = _WEARER.get(key)
+    if hit is not None and hit[0] is garment.material:
+        return hit[1]
+    if len(_WEARER) > 64:
+        _WEARER.clear()
+    look = facial_hair.for_wearer(garment.material, kind, age, colour)
+    _WEARER[key] = (garment.material, look)
+    return look
 
 
 def parts(outfit: Outfit) -> list[MeshPart]:

@@ -1,8 +1,11 @@
-"""Facial hair materials: strand cards of beards and moustaches, and tiled stubble.
+"""Facial hair materials: strand cards of beards and moustaches, and stubble; and how
+brows and facial hair follow the wearer (hair colour, greying with age).
 
 Beards and moustaches use the hair layout of ``textures`` (strand cards, roots at
-v = 0.5); stubble is a tileable texture of short hairs cut a day or three ago, drawn
-on a layer lifted just off the skin (``clothes.face.stubble``, one repeat per 3 cm).
+v = 0.5); stubble is an atlas of short hairs cut a day or three ago over the whole beard
+area (``clothes.face.stubble``'s UVs: u the arc round the face, v the height from the
+mouth, both in metres over ``STUBBLE_SPAN_M``), its density fading to nothing over a
+centimetre at the beard's edges (``beard_edge``).
 """
 
 from __future__ import annotations
@@ -14,45 +17,137 @@ import numpy as np
 from avatar.looks import fabrics, textures
 from avatar.material import Material
 
+# Where a full beard grows, by the direction around the head (degrees from the front): its
+# upper edge above the mouth (m). From the moustache under the nose it drops to the corner
+# of the mouth, then the cheek line climbs diagonally across the cheek to the sideburns in
+# front of the ears (seen from the front, a line from the mouth's corner to the ear, not a
+# level cut across the face). ``clothes.face`` cuts the beard's pieces along this line.
+CHEEK_DEG = (0, 10, 18, 24, 32, 45, 58, 70, 80, 88)
+CHEEK_M = (0.017, 0.014, 0.006, 0.004, 0.012, 0.024, 0.036, 0.05, 0.062, 0.066)
+EDGE_M = 0.01  # the beard thins out over this band at its edges (density 1 -> 0)
+WOBBLE_M = 0.004  # how far the edge wanders off the line (irregular, as hair grows)
+ARC_RADIUS_M = 0.075  # stubble u: arc length round the face at about this radius
+
+# The stubble atlas: u over [-SPAN_U, SPAN_U] m of arc, v over [V_LOW, V_HIGH] m from the
+# mouth (a canonical adult's: ``clothes.face.stubble`` maps the throat's edge to STUBBLE_
+# THROAT_M). One tile of stubs repeats every STUBBLE_TILE_M across it.
+STUBBLE_SPAN_U = 0.135
+STUBBLE_V = (-0.11, 0.08)
+STUBBLE_THROAT_M = -0.074  # the beard's lower edge (2 cm under the chin), default adult
+STUBBLE_TILE_M = 0.03
+
+# Greying (MakeHuman age: 0.5 = 25 years, 1 = 90): grey strands appear from GREY_FROM and
+# make up GREY_MOST of the hair at age 1.
+GREY_FROM, GREY_MOST = 0.6, 0.9
+GREY_RGB = np.array([0.62, 0.61, 0.58], np.float32)  # linear: white-grey hair
+
+
+def _soft(x: np.ndarray) -> np.ndarray:
+    """A smooth step from 0 (x <= -0.5) to 1 (x >= 0.5), x in units of the edge's width."""
+    t = np.clip(x + 0.5, 0, 1)
+    return t * t * (3 - 2 * t)
+
+
+def beard_edge(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
+    """(N,) density of a full beard from its upper (cheek) line and its back edge in front
+    of the ears, 0..1, falling off over ``EDGE_M``: turn_deg, degrees round the head from
+    the front (absolute); rel_z, m above the mouth. (The throat's edge depends on the chin:
+    ``clothes.face.facial_hair_density``.)"""
+    angle = np.radians(turn_deg)
+    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
+    top = np.interp(turn_deg, CHEEK_DEG, CHEEK_M) + wobble
+    back = np.radians(88 - turn_deg) * 0.08
+    return _soft((top - rel_z) / EDGE_M) * _soft(back / (0.6 * EDGE_M))
+
+
+def grey_share(age: float) -> float:
+    """Share of grey strands at MakeHuman ``age`` (0 below ``GREY_FROM``, salt and pepper
+    in the sixties, ``GREY_MOST`` at 1)."""
+    t = np.clip((age - GREY_FROM) / (1 - GREY_FROM), 0, 1)
+    return float(GREY_MOST * t**0.8)
+
 
 def beard_material(spec, size: int = 1024) -> Material:
     """A beard's or moustache's cut-out strand material in the spec's hair colour (the
     scalp hair's, ``textures.hair_material``) with its card strands thinned: beard hair is
     sparse, so only about two hair-wide columns in five are kept and skin shows between
-    them (a card of scalp strands would read as a solid block on the face)."""
+    them (a card of scalp strands would read as a solid block on the face); and the kept
+    strands end raggedly (each tip at its own length, a fine taper instead of a cut) so the
+    moustache's and beard's outline breaks up into hairs."""
     m = textures.hair_material(spec, size)
     colour = np.array(m.base_color_texture, copy=True)
     rng = np.random.default_rng([size, 17])
     hair = max(size // 340, 1)  # texels per hair across (a card's ~0.1 mm at 1024 px)
     kept = np.repeat(rng.uniform(size=size // hair + 1) < 0.4, hair)[:size]
-    cards = slice(size - size // 2, size)  # rows of the strand-card half (v in [0, 0.5])
-    colour[cards, :, 3] = colour[cards, :, 3] * kept[None, :]
+    half = size // 2
+    cards = slice(size - half, size)  # rows of the strand-card half (v in [0, 0.5])
+    # Ragged tips: every hair column ends at its own length (60..100 % of the card) over a
+    # soft taper, and the strand gap texels next to kept ones are half-covered (fine hairs).
+    length = np.repeat(rng.uniform(0.6, 1.0, size // hair + 1), hair)[:size]
+    t = (np.arange(half) + 0.5) / half  # roots (0) to tips (1) down the card half
+    tip = np.clip((length[None, :] - t[:, None]) / 0.25, 0, 1)
+    fine = np.convolve(kept.astype(np.float32), np.ones(3) / 3, "same") * 0.35
+    cover = np.maximum(kept.astype(np.float32), fine)[None, :] * tip
+    colour[cards, :, 3] = np.round(colour[cards, :, 3] * cover).astype(np.uint8)
     return replace(m, base_color_texture=colour)
 
 
 def stubble_alpha(size: int, seed: int = 0) -> np.ndarray:
-    """(S, S) uint8 tileable alpha of stubble: a faint shadow of hair under the skin and
-    some sixteen hundred short stubs, each a fraction of a millimetre thick and one to two
-    long, pointing down the face (the texture's -v) with some scatter."""
+    """(S, S) uint8 alpha of a tileable stubble tile (wraps in u and v): a faint shadow of
+    hair under the skin and some two thousand short stubs, each a fraction of a millimetre
+    thick and one to two long, pointing down the face (the texture's -v) with scatter."""
     rng = np.random.default_rng([seed, size, 13])
-    canvas = np.zeros((size, size), np.float32)
-    count = 1600
-    start = rng.uniform([0, 0.03 * size], [size, 0.95 * size], (count, 2))
+    pad = int(0.06 * size) + 2
+    canvas = np.zeros((size + pad, size), np.float32)  # stubs running off the bottom
+    count = 2000
+    start = rng.uniform([0, 0], [size, size], (count, 2))
     angle = np.radians(90 + rng.normal(0, 25, count))  # image rows run down
     length = size * rng.uniform(0.02, 0.045, count)
     for p, a, n in zip(start, angle, length, strict=True):
         points = np.array([p, p + n * np.array([np.cos(a), np.sin(a)])], np.float32)
         width = np.array([0.0045, 0.003], np.float32) * size
-        textures.stroke(canvas, points, np.maximum(width, 0.8), rng.uniform(0.6, 0.9), wrap=True)
-    return np.round(np.clip(0.1 + 0.8 * canvas, 0, 1) * 255).astype(np.uint8)
+        textures.stroke(canvas, points, np.maximum(width, 0.8), rng.uniform(0.7, 1.0), wrap=True)
+    tile = canvas[:size].copy()
+    tile[:pad] = np.maximum(tile[:pad], canvas[size:])  # ... wrap round to the top rows
+    return np.round(np.clip(0.04 + 0.96 * tile, 0, 1) * 255).astype(np.uint8)
+
+
+def stubble_density(shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) float32 density of stubble over the atlas (row 0 the top, v = 1): 1 inside
+    the beard area, 0 outside, falling off over ``EDGE_M`` at its cheek line, in front of
+    the ears and under the chin (``STUBBLE_THROAT_M``)."""
+    h, w = shape
+    u = (np.arange(w) + 0.5) / w
+    v = 1 - (np.arange(h) + 0.5) / h
+    arc = (2 * u - 1) * STUBBLE_SPAN_U
+    rel_z = STUBBLE_V[0] + v * (STUBBLE_V[1] - STUBBLE_V[0])
+    turn = np.degrees(np.abs(arc) / ARC_RADIUS_M)
+    t, z = np.meshgrid(turn, rel_z)
+    d = beard_edge(t.ravel(), z.ravel()).reshape(h, w)
+    return (d * _soft((z - STUBBLE_THROAT_M) / EDGE_M)).astype(np.float32)
+
+
+def stubble_atlas(size: int) -> np.ndarray:
+    """(H, W) uint8 alpha of the stubble atlas: the tile (``stubble_alpha``, one repeat
+    per ``STUBBLE_TILE_M``) repeated over the beard area, times ``stubble_density``.
+    size: texels of one tile before it is averaged down 4:1 (1024: ~8.5 px per mm)."""
+    tile = stubble_alpha(size).astype(np.float32)
+    k = 4 if size >= 64 else 1
+    tile = tile.reshape(size // k, k, size // k, k).mean(axis=(1, 3))
+    per_m = tile.shape[0] / STUBBLE_TILE_M
+    w = int(round(2 * STUBBLE_SPAN_U * per_m))
+    h = int(round((STUBBLE_V[1] - STUBBLE_V[0]) * per_m))
+    reps = (h // tile.shape[0] + 1, w // tile.shape[1] + 1)
+    alpha = np.tile(tile, reps)[:h, :w] * stubble_density((h, w))
+    return np.round(alpha).astype(np.uint8)
 
 
 def stubble_material(spec, size: int = 1024) -> Material:
-    """Stubble in the spec's hair colour: blended (glTF ``BLEND``) over the skin, so the
-    stubs and the shadow between them darken it without hard edges."""
-    alpha = stubble_alpha(size)
-    rgb = fabrics.rgb(spec.colour).astype(np.float32) * 0.8
-    colour = np.concatenate([np.broadcast_to(fabrics.srgb(rgb), (size, size, 3)),
+    """Stubble in the spec's hair colour: short dark stubs blended (glTF ``BLEND``) over
+    the skin, thinning out at the beard's edges (``stubble_atlas``)."""
+    alpha = stubble_atlas(size)
+    rgb = fabrics.rgb(spec.colour).astype(np.float32) * 0.7
+    colour = np.concatenate([np.broadcast_to(fabrics.srgb(rgb), alpha.shape + (3,)),
                              alpha[..., None]], -1)  # fmt: skip
     return Material(
         name=spec.name,
@@ -62,3 +157,53 @@ def stubble_material(spec, size: int = 1024) -> Material:
         double_sided=False,
         extras={"fabric": "stubble", "colour": spec.colour},
     )
+
+
+def for_wearer(material: Material, kind: str, age: float, colour=None) -> Material:
+    """``material`` of a brow or facial-hair built-in recoloured for its wearer.
+
+    kind: "brows" (``textures.hair_material``'s brow shade of ``colour``), "cards" (beard,
+    moustache: strand cards) or "stubble". age: MakeHuman's age (0..1): grey strands mix in
+    from ``GREY_FROM`` (``grey_share``), and a child's brows are fainter and lighter.
+    colour: the wearer's hair colour (a name or linear RGB), or None to keep the
+    material's own. Returns a new Material (the texture's alpha is kept, but for a
+    child's brows)."""
+    tex = material.base_color_texture
+    assert tex is not None and tex.shape[2] == 4, "a hair material with alpha"
+    size = tex.shape[:2]
+    if colour is not None:
+        rgb = fabrics.rgb(colour).astype(np.float32)
+        if kind == "brows":
+            rgb = rgb * textures.brow_shade(rgb)
+        elif kind == "stubble":
+            rgb = rgb * 0.7
+        shade = np.ones(size, np.float32)
+        if kind == "cards":  # keep the strands' shading from the material's own colour
+            own = _linear(tex[..., :3]).mean(-1)
+            shown = own[tex[..., 3] > 127]
+            shade = own / max(float(np.median(shown)) if shown.size else 1.0, 1e-4)
+        lin = rgb[None, None, :] * shade[..., None]
+    else:
+        lin = _linear(tex[..., :3])
+    share = grey_share(age)
+    if share > 0:
+        rng = np.random.default_rng([size[0], size[1], 31])
+        if kind == "cards":  # whole strands grey: salt and pepper
+            grey = np.broadcast_to(rng.uniform(size=size[1])[None, :] < share, size)
+        else:
+            grey = rng.uniform(size=size) < share
+        white = GREY_RGB * (0.8 if kind == "brows" else 1.0)
+        lin = np.where(grey[..., None], white[None, None, :], lin)
+    alpha = tex[..., 3]
+    if kind == "brows" and age < 0.3:  # a child's brows: fine, fair, faint
+        young = float(np.clip((0.3 - age) / 0.3, 0, 1))
+        lin = lin * (1 - 0.35 * young) + 0.35 * young * np.clip(lin * 2.2, 0, 1)
+        alpha = np.round(alpha * (1 - 0.35 * young)).astype(np.uint8)
+    out = np.concatenate([fabrics.srgb(lin), alpha[..., None]], -1)
+    return replace(material, base_color_texture=np.ascontiguousarray(out))
+
+
+def _linear(srgb_u8: np.ndarray) -> np.ndarray:
+    """(..., 3) float32 linear values of sRGB bytes."""
+    s = srgb_u8.astype(np.float32) / 255
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4).astype(np.float32)

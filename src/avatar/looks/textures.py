@@ -120,7 +120,8 @@ def brow_alpha(size: int, seed: int = 0) -> np.ndarray:
     centre, half = brow_shape(u)
     across = rng.uniform(-1.2, 1.2, len(u))  # -1 lower edge, +1 upper edge
     v = centre + half * across
-    opacity = rng.uniform(0.75, 1.0, len(u)) * np.clip((1.25 - np.abs(across)) / 0.45, 0, 1)
+    # Hairs thin out over the outer third of the brow's width: a soft edge, not a line.
+    opacity = rng.uniform(0.75, 1.0, len(u)) * np.clip((1.3 - np.abs(across)) / 0.75, 0, 1)
     keep = (half > 0.01) & (opacity > 0.05)
     for ui, vi, ai, oi in zip(u[keep], v[keep], across[keep], opacity[keep], strict=True):
         # Degrees from the +u axis: ~75 at the head, ~20 along the body, ~5 at the tail,
@@ -167,6 +168,14 @@ def strand_shade(size: int, seed: int = 0) -> np.ndarray:
     return (along[:, None] * strand[None, :]).astype(np.float32)
 
 
+def brow_shade(rgb: np.ndarray) -> float:
+    """Brightness factor of brow hair over scalp hair of linear colour ``rgb`` (3,): dark
+    hair's brows about as dark as the hair, fair hair's a few shades deeper so they read
+    against fair skin."""
+    lum = float(np.asarray(rgb, np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32))
+    return float(np.interp(lum, [0.03, 0.3], [0.9, 0.55]))
+
+
 def hair_material(spec, size: int = 1024) -> Material:
     """The Material of a hair or face built-in: strand colour, normal and roughness maps
     of the ``hair`` fabric in the spec's colour, and the strand alpha of its kind.
@@ -184,9 +193,9 @@ def hair_material(spec, size: int = 1024) -> Material:
     m = fabrics.material("hair", spec.colour, size, name=spec.name, alpha=alpha)
     rgb = fabrics.rgb(spec.colour)[None, None, :] * shade[..., None]
     if spec.name.startswith("eyebrows"):
-        # Brow hairs are coarser and darker than scalp hair of the same colour: blond brows
-        # a shade deeper, so they read against fair skin.
-        rgb = rgb * 0.5
+        # Brow hairs are about the hair's colour: dark hair's brows as dark, blond brows a
+        # few shades deeper so they read against fair skin (not the near-black of a pencil).
+        rgb = rgb * brow_shade(fabrics.rgb(spec.colour))
     colour = np.concatenate([fabrics.srgb(rgb), alpha[..., None]], -1)
     # Hair is a fibre, not a mirror: a weaker specular keeps dark hair from glaring white.
     extras = {**m.extras, "specular": 0.3}
