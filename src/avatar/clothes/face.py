@@ -326,7 +326,7 @@ def stubble(body: AuthoringBody) -> Piece:
     mesh = cut(body, faces, facial_hair_mask(body, "beard"), 0.0005, relax=4)
     centre, mouth, _, chin_z = mouth_frame(body)
     p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, 4, 3)
-    rel = p - centre
+    rel = p - (centre - [0.0, fh.STUBBLE_BACK_M, 0.0])  # the beard's back cut: 90 degrees
     angle = np.arctan2(rel[..., 0], -rel[..., 1])  # round the head
     arc = angle * fh.ARC_RADIUS_M
     rel_z = p[..., 2] - mouth[2]

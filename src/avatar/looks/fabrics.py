@@ -43,9 +43,13 @@ FABRICS = {
     "cotton": Fabric("cotton", "plain", 180, 1.2, 0.85, 0.12),
     "denim": Fabric("denim", "twill", 120, 2.0, 0.8, 0.2, weft=(0.42, 0.4, 0.34),
                     weft_share=0.3, slub=0.18, relief=0.3, rough_weave=0.16),
-    "knit": Fabric("knit", "knit", 36, 2.5, 0.9, 0.25),
+    # A knit's loops are in its relief (normal map); its colour varies only faintly with
+    # them, or the fine V-loops shimmer (moire) at a distance and their direction shows.
+    "knit": Fabric("knit", "knit", 36, 2.5, 0.9, 0.06),
     "jersey": Fabric("jersey", "knit", 90, 1.2, 0.8, 0.1),
-    "leather": Fabric("leather", "grain", 40, 1.5, 0.45, 0.15),
+    # Garment leather: a soft satin-to-matte grain (roughness ~0.55-0.7, gently varied),
+    # shallow, so it reads as leather rather than crinkled wet plastic with glittery specks.
+    "leather": Fabric("leather", "grain", 40, 0.35, 0.62, 0.05, rough_weave=0.09),
     "canvas": Fabric("canvas", "plain", 70, 1.8, 0.9, 0.2),
     "lycra": Fabric("lycra", "knit", 160, 0.6, 0.35, 0.06),
     "wool": Fabric("wool", "twill", 60, 2.2, 0.95, 0.25),

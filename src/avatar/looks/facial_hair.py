@@ -35,6 +35,8 @@ STUBBLE_SPAN_U = 0.135
 STUBBLE_V = (-0.11, 0.08)
 STUBBLE_THROAT_M = -0.074  # the beard's lower edge (2 cm under the chin), default adult
 STUBBLE_TILE_M = 0.03
+STUBBLE_INSET_M = 0.005  # stubble fades out this far inside the beard's cheek line
+STUBBLE_BACK_M = 0.01  # u's angle is measured about the skull centre moved this far forward
 
 # Greying (MakeHuman age: 0.5 = 25 years, 1 = 90): grey strands appear from GREY_FROM and
 # make up GREY_MOST of the hair at age 1.
@@ -114,8 +116,10 @@ def stubble_alpha(size: int, seed: int = 0) -> np.ndarray:
 
 def stubble_density(shape: tuple[int, int]) -> np.ndarray:
     """(H, W) float32 density of stubble over the atlas (row 0 the top, v = 1): 1 inside
-    the beard area, 0 outside, falling off over ``EDGE_M`` at its cheek line, in front of
-    the ears and under the chin (``STUBBLE_THROAT_M``)."""
+    the beard area, 0 outside, falling off over ``EDGE_M`` just inside the beard's cheek
+    line (``STUBBLE_INSET_M`` below it), in front of the ears (u's angle measured about
+    the point where ``clothes.face`` cuts the beard off at the back: 0 at 90 degrees) and
+    under the chin (``STUBBLE_THROAT_M``)."""
     h, w = shape
     u = (np.arange(w) + 0.5) / w
     v = 1 - (np.arange(h) + 0.5) / h
@@ -123,8 +127,16 @@ def stubble_density(shape: tuple[int, int]) -> np.ndarray:
     rel_z = STUBBLE_V[0] + v * (STUBBLE_V[1] - STUBBLE_V[0])
     turn = np.degrees(np.abs(arc) / ARC_RADIUS_M)
     t, z = np.meshgrid(turn, rel_z)
-    d = beard_edge(t.ravel(), z.ravel()).reshape(h, w)
-    return (d * _soft((z - STUBBLE_THROAT_M) / EDGE_M)).astype(np.float32)
+    angle = np.radians(t)
+    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
+    top = np.interp(t, CHEEK_DEG, CHEEK_M) + wobble - STUBBLE_INSET_M
+    back = np.radians(90 - t) * ARC_RADIUS_M  # m of arc in front of the cut
+    d = (
+        _soft((top - z) / EDGE_M)
+        * _soft((back - 0.5 * EDGE_M) / EDGE_M)
+        * _soft((z - STUBBLE_THROAT_M) / EDGE_M)
+    )
+    return d.astype(np.float32)
 
 
 def stubble_atlas(size: int) -> np.ndarray:
