@@ -204,7 +204,7 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
             grey = np.broadcast_to(rng.uniform(size=size[1])[None, :] < share, size)
         else:
             grey = rng.uniform(size=size) < share
-        white = GREY_RGB * (0.8 if kind == "brows" else 1.0)
+        white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey
         lin = np.where(grey[..., None], white[None, None, :], lin)
     alpha = tex[..., 3]
     if kind == "brows" and age < 0.3:  # a child's brows: fine, fair, faint
