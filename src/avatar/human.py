@@ -298,7 +298,8 @@ class Human:
         faces = np.sort(np.concatenate([base.face_groups[g] for g in BODY_PART_GROUPS[name]]))
         mesh = base.with_vertices(self.vertices).subset(faces)
         if name == "teeth":  # spread over the teeth-and-gums texture (looks.skin)
-            return face.teeth(mesh, np.isin(faces, base.face_groups["helper-upper-teeth"]))
+            return face.teeth(mesh, np.isin(faces, base.face_groups["helper-upper-teeth"]),
+                              self.model)  # fmt: skip
         return _eye_uvs(mesh, faces, base) if name == "eyes" else mesh
 
     def part_vertices(self, name: str) -> np.ndarray:

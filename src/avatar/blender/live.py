@@ -39,7 +39,7 @@ from avatar.blender.scene import CharacterObjects, new_collection
 from avatar.body import shaped
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body
-from avatar.clothes import builtin, footing, library
+from avatar.clothes import builtin, face, footing, library
 from avatar.clothes.binding import fit
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.errors import AvatarError
@@ -80,8 +80,12 @@ class Geometry:
         return Body(self.vertices, skeleton, weights, self.model, rig)
 
     def part_vertices(self, part: str) -> np.ndarray:
-        """(n, 3) float32 the vertices of a body part ("body", "eyes") in its mesh's order."""
-        return self.vertices[_part_index(self.model, part)]
+        """(n, 3) float32 the vertices of a body part ("body", "eyes", "teeth", "tongue") in
+        its mesh's order, as ``Human.part`` makes them (teeth seated in their bite)."""
+        vertices = self.vertices[_part_index(self.model, part)]
+        if part == "teeth":
+            vertices = face.seat(vertices, *face.model_bite(self.model))
+        return vertices
 
 
 def geometry(

@@ -5,6 +5,8 @@ the UVs of the teeth over their teeth-and-gums texture."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
@@ -94,10 +96,15 @@ def _hops(faces: np.ndarray, count: int, sources: list[int]) -> np.ndarray:
         dist = new
 
 
-def teeth(mesh: Mesh, upper: np.ndarray) -> Mesh:
+def teeth(mesh: Mesh, upper: np.ndarray, model=None) -> Mesh:
     """The teeth part as it renders: UVs over the teeth texture (``teeth_uvs``) and the
-    front teeth seated in a natural bite (``seat_teeth``). mesh, upper: as ``teeth_uvs``."""
-    return seat_teeth(teeth_uvs(mesh, upper), upper)
+    front teeth seated in a natural bite (``seat_teeth``). mesh, upper: as ``teeth_uvs``.
+    ``model``: the BodyModel the mesh is a part of, whose base mesh then gives the arch
+    positions (``model_bite``), so that every path that writes teeth (a Human's parts, the
+    Blender extension's live updates) seats them identically."""
+    mesh = teeth_uvs(mesh, upper)
+    weights = model_bite(model) if model is not None else bite(mesh, upper)
+    return mesh.with_vertices(seat(mesh.vertices, *weights))
 
 
 # The front of the arch (incisors, canines) is moved, fading out over the premolars: u is
@@ -120,6 +127,13 @@ def seat_teeth(mesh: Mesh, upper: np.ndarray) -> Mesh:
     mesh: the teeth part with ``teeth_uvs``' UVs (their u is the arch position); upper:
     (F,) bool, its faces of the upper row. Returns the mesh with moved vertices.
     """
+    return mesh.with_vertices(seat(mesh.vertices, *bite(mesh, upper)))
+
+
+def bite(mesh: Mesh, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V,) float32 share of the bite's shift per vertex (1 over the incisors, fading to 0
+    over the premolars) and (V,) bool the upper row's vertices, of a teeth part with
+    ``teeth_uvs``' UVs; upper: (F,) bool, its faces of the upper row."""
     assert mesh.uvs is not None and mesh.face_uvs is not None, "teeth_uvs first"
     u = np.zeros(len(mesh.vertices), np.float32)
     u[mesh.faces.ravel()] = mesh.uvs[mesh.face_uvs.ravel(), 0]
@@ -127,11 +141,31 @@ def seat_teeth(mesh: Mesh, upper: np.ndarray) -> Mesh:
     front = front * front * (3 - 2 * front)  # smoothstep: no kink in the arch
     is_upper = np.zeros(len(mesh.vertices), bool)
     is_upper[mesh.faces[upper].ravel()] = True
-    incisors = mesh.vertices[is_upper & (front == 1)]
+    for array in (front, is_upper):
+        array.flags.writeable = False  # cached and shared by model_bite
+    return front, is_upper
+
+
+def seat(vertices: np.ndarray, front: np.ndarray, is_upper: np.ndarray) -> np.ndarray:
+    """(V, 3) teeth vertices in the bite ``bite`` describes (a few vector operations: cheap
+    enough for every step of a slider drag)."""
+    incisors = vertices[is_upper & (front == 1)]
     height = float(np.ptp(incisors[:, 2]))  # gum to biting edge, ~16 mm on an adult
     shift = np.where(is_upper[:, None], [0.0, -OVERJET_M[0], -OVERBITE * height],
                      [0.0, OVERJET_M[1], 0.0])  # fmt: skip
-    return mesh.with_vertices(mesh.vertices + front[:, None] * shift)
+    return (vertices + front[:, None] * shift).astype(vertices.dtype)
+
+
+@functools.lru_cache(maxsize=4)
+def model_bite(model) -> tuple[np.ndarray, np.ndarray]:
+    """``bite`` of a BodyModel's teeth part on its base mesh: the arch positions are the
+    topology's, the same for every body made from the model."""
+    from avatar.body.shaped import PART_GROUPS
+
+    base = model.base
+    faces = np.sort(np.concatenate([base.face_groups[g] for g in PART_GROUPS["teeth"]]))
+    upper = np.isin(faces, base.face_groups["helper-upper-teeth"])
+    return bite(teeth_uvs(base.subset(faces), upper), upper)
 
 
 def teeth_uvs(mesh: Mesh, upper: np.ndarray) -> Mesh:
