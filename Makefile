@@ -10,6 +10,7 @@ setup:
 	@bash scripts/setup.sh
 
 demo: setup
+	mkdir -p $(OUT)
 	$(VENV)/avatar create --set gender=0.3 --set age=0.45 --set muscle=0.6 \
 		--wear tshirt --wear jeans --wear shoes --wear hair-short --wear eyebrows --wear eyelashes \
 		--motion walk -o $(OUT)/demo.glb --render $(OUT)/demo.png
