@@ -135,3 +135,15 @@ def test_not_a_character(empty_scene):
         character.update(obj, {"params": {}})
     with pytest.raises(AvatarError):
         character.apply_motion(obj, SimpleNamespace())
+
+
+def test_trees_are_built_before_the_call_returns_inside_blender():
+    """A k-d tree thread still running when the next operator ran crashed Blender (a
+    segfault in CI, in mode_set during character.create): with bpy loaded, a tree asked for
+    "later" is built at once, so no Python thread runs while Blender works."""
+    import bpy  # noqa: F401  (the condition the tree builder looks at)
+
+    from avatar.geometry.nearest import PointTree
+
+    future = PointTree.later(np.random.default_rng(0).random((500, 3)))
+    assert future.done() and len(future.result()) == 500

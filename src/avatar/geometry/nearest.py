@@ -10,6 +10,7 @@ missing (a Blender whose Python lacks it) scipy's tree answers the same queries.
 from __future__ import annotations
 
 import os
+import sys
 from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
@@ -38,6 +39,12 @@ class PointTree:
         """A tree built on a background thread (the build runs without the GIL), for a
         caller with other work to do before its first search."""
         points = np.array(points, dtype=np.float32)  # the caller may reuse its array
+        if "bpy" in sys.modules:
+            # Inside Blender a Python thread still running when the caller goes on to an
+            # operator (mode_set, ...) crashed Blender (a segfault in CI), so build it now.
+            done: Future[PointTree] = Future()
+            done.set_result(cls(points))
+            return done
         if not _BUILDER or _BUILDER[0][0] != os.getpid():
             _BUILDER[:] = [(os.getpid(), ThreadPoolExecutor(1, "avatar-kdtree"))]
         return _BUILDER[0][1].submit(cls, points)
