@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
-from avatar.clothes.contacts import remote_contacts
+from avatar.clothes.contacts import REMOTE_K, remote_contacts
 from avatar.geometry import collision
 from avatar.rig.skinning import SkinWeights, linear_blend
 
@@ -37,6 +37,7 @@ class Outfit:
     # skin vertex at rest.
     anchors: list[tuple[np.ndarray, ...] | None] = field(default_factory=list)
     rest_body: np.ndarray | None = None  # (13380, 3) skin at rest, to tell remote contacts
+    body_weights: SkinWeights | None = None  # the body's skin weights (rigid groups)
 
     # An Outfit reads as the list of its FittedGarments.
     def __iter__(self):
@@ -108,15 +109,17 @@ class Outfit:
         qo = body.anchored(outer, lay.outer_triangle, lay.outer_bary)
         outer = collision.push_out(outer, qo, lay.outer_need)
         # One search for all garments, both shell layers (where the body folds, the outer
-        # one can reach the next part); each point is checked on its own.
-        order = lay.remote_order
-        joined = remote_contacts(
+        # one can reach the next part); each point is checked on its own, except points
+        # that moved with one bone as all skin near them did (they sit as at rest).
+        joined = np.concatenate([inner, outer])[lay.remote_order]
+        check = self._rigid.changed(body.vertices, joined, matrices)
+        joined[check] = remote_contacts(
             body,
             self.rest_rows,
-            np.concatenate([inner, outer])[order],
-            lay.remote_need,
-            lay.remote_near,
-            np.concatenate([q.normal, qo.normal])[order],
+            joined[check],
+            lay.remote_need[check],
+            lay.remote_near[check],
+            np.concatenate([q.normal, qo.normal])[lay.remote_order][check],
             iterations=4,
         )
         out = np.split(skinned, lay.splits)
@@ -128,6 +131,10 @@ class Outfit:
     @cached_property
     def _layout(self) -> _FrameLayout:
         return _FrameLayout.of(self)
+
+    @cached_property
+    def _rigid(self) -> _RigidPoints:
+        return _RigidPoints.of(self, self._layout)
 
 
 @dataclass(frozen=True, eq=False)
@@ -199,6 +206,113 @@ class _FrameLayout:
             remote_splits=np.cumsum(sizes)[:-1],
             colliding_garments=[i for i, _, _ in hits],
         )
+
+
+FIRM = 0.99  # weight on one bone above which a vertex all but moves with that bone
+RIGID_POINTS = 1000  # fewest such garment points on one bone worth leaving out
+CLEAR = 0.01  # m: other skin further than this beyond a point's REMOTE_K-th nearest is no contact
+STILL = 2e-4  # m a firm vertex may move in its bone's frame and still count as unmoved
+
+
+@dataclass(frozen=True, eq=False)
+class _RigidPoints:
+    """Garment points that move with one bone, as does the skin round them (short hair on
+    the head: ~9,000 card vertices, most of a frame's remote-contact search). Where that
+    skin and the point have moved less than STILL in the bone's frame, and skin moving
+    otherwise (the neck under the head) has not come near, the point sits on the skin as
+    at rest and the search can leave it out; the full search would move it at most 2 STILL
+    (0.4 mm; clearances are millimetres). "Near" is measured in the bone's frame: a point
+    is left out while its rest distance to the nearest skin vertex not firm on the bone,
+    less how far the worst such vertex within reach moved (a hand raised to the head moves
+    far and brings every point back in), exceeds its rest distance to its REMOTE_K-th
+    nearest skin vertex plus CLEAR."""
+
+    count: int  # remote-contact rows
+    bones: list[int]
+    rows: list[np.ndarray]  # per bone: (P,) remote rows of the points it moves most
+    rest_points: list[np.ndarray]  # per bone: (P, 3) their rest positions
+    slack: list[np.ndarray]  # per bone: (P,) m the soft skin may close in
+    firm: list[np.ndarray]  # per bone: (V,) bool skin vertices firm on it
+    box: list[np.ndarray]  # per bone: (2, 3) the points' rest box, grown by their reach
+    rest: np.ndarray  # (V, 3) float32 the rest skin
+
+    @classmethod
+    def of(cls, outfit: Outfit, lay: _FrameLayout) -> _RigidPoints:
+        from scipy.spatial import cKDTree
+
+        skin = np.zeros((0, 3), np.float32)
+        if outfit.rest_body is not None:
+            skin = np.asarray(outfit.rest_body[:BODY_VERTICES], np.float32)
+        found = cls(len(lay.remote_order), [], [], [], [], [], [], skin)
+        # Inner-layer rows only (a shell's outer layer also follows the skin's normals).
+        at = np.flatnonzero(lay.remote_order < len(lay.colliding))
+        inner = lay.colliding[lay.remote_order[at]]
+        if outfit.body_weights is None or len(skin) == 0 or len(inner) == 0:
+            return found
+        skin_bone, skin_weight = _top_bone(outfit.body_weights, len(skin))
+        point_bone, point_weight = _top_bone(lay.weights, len(lay.rest))
+        point_bone = np.where(point_weight[inner] >= 0.5, point_bone[inner], -1)
+        points = lay.rest[inner]
+        own = cKDTree(skin).query(points, k=REMOTE_K)[0][:, -1]
+        for bone in np.unique(point_bone[point_bone >= 0]):
+            rows = np.flatnonzero(point_bone == bone)
+            firm = (skin_bone == bone) & (skin_weight >= FIRM)
+            if len(rows) < RIGID_POINTS or firm.all():
+                continue
+            reach = own[rows] + CLEAR
+            slack = cKDTree(skin[~firm]).query(points[rows])[0] - reach
+            grow = reach.max()
+            box = np.stack([points[rows].min(0) - grow, points[rows].max(0) + grow])
+            found.bones.append(int(bone))
+            found.rows.append(at[rows])
+            found.rest_points.append(points[rows])
+            found.slack.append(slack.astype(np.float32))
+            found.firm.append(firm)
+            found.box.append(box.astype(np.float32))
+        return found
+
+    def changed(self, skin: np.ndarray, points: np.ndarray, matrices: np.ndarray) -> np.ndarray:
+        """(count,) bool: the remote rows to search in this pose (skin (V, 3) and the
+        remote-contact points (count, 3) posed by the skinning matrices (J, 4, 4))."""
+        check = np.ones(self.count, bool)
+        for bone, rows, rest_points, slack, firm, box in zip(
+            self.bones, self.rows, self.rest_points, self.slack, self.firm, self.box,
+            strict=True,
+        ):  # fmt: skip
+            back = np.linalg.inv(matrices[bone]).astype(np.float32)  # posed -> the bone's rest
+            local = skin @ back[:3, :3].T + back[:3, 3]
+            near = _inside(local, box)
+            moved = _lengths(local[near] - self.rest[near])
+            if moved[firm[near]].max(initial=0.0) > STILL:
+                continue  # the skin under the points itself moved: search them all
+            drift = moved[~firm[near]].max(initial=0.0)
+            own = _lengths(points[rows] @ back[:3, :3].T + back[:3, 3] - rest_points)
+            apart = (slack > drift) | (drift <= STILL)
+            check[rows[apart & (own <= STILL)]] = False
+        return check
+
+
+def _top_bone(weights: SkinWeights, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """(count,) the bone with the largest weight on each of the first ``count`` vertices,
+    and that weight."""
+    w, idx = weights.weights[:count], weights.indices[:count]
+    top = np.argmax(w, axis=1)
+    rows = np.arange(count)
+    return idx[rows, top], w[rows, top]
+
+
+def _inside(points: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """(N,) indices of the points (N, 3) inside the box (2, 3), one axis at a time (a third
+    of the time of a whole (N, 3) comparison)."""
+    at = np.arange(len(points))
+    for axis in range(3):
+        column = points[at, axis]
+        at = at[(column >= box[0, axis]) & (column <= box[1, axis])]
+    return at
+
+
+def _lengths(v: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.einsum("nd,nd->n", v, v))
 
 
 def _cat(arrays: list, dtype, width: int | None = None) -> np.ndarray:
