@@ -52,6 +52,15 @@ SETS["tops"] = [  # cap and hood from the shoulders up
     ({"gender": 0.0, "age": 0.12}, ("eyebrows", "eyelashes", "hair-bob", "hoodie", "cap")),
     ({"gender": 0.0, "age": 0.4}, ("eyebrows", "eyelashes", "hair-long", "dress")),
 ]  # fmt: skip
+SETS["hair"] = [  # issue 14's hair and facial-hair checks: ages, long and tied hair, a cap
+    ({"gender": 1.0, "age": 0.45}, ("eyebrows", "eyelashes", "hair-short", "stubble")),
+    ({"gender": 1.0, "age": 0.95}, ("eyebrows", "eyelashes", "hair-short", "moustache")),
+    ({"gender": 0.0, "age": 0.95}, ("eyebrows", "eyelashes", "hair-bob")),
+    ({"gender": 0.0, "age": 0.45}, ("eyebrows", "eyelashes", "hair-long")),
+    ({"gender": 0.0, "age": 0.35}, ("eyebrows", "eyelashes", "hair-ponytail")),
+    ({"gender": 0.0, "age": 0.3}, ("eyebrows", "eyelashes", "hair-bob")),
+    ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short", "cap")),
+]  # fmt: skip
 CROWN_AIM = 1.8 - 0.32  # tops: crowns put at 1.8 m (as heads), the camera on the shoulders
 # set -> (metres between bodies, frame height / width per body, aim height (m))
 FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM)}
@@ -59,7 +68,7 @@ FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM)}
 # and the views (name -> direction from subject to camera).
 VIEWS = {
     "front": (0.0, -1.0, 0.05), "side": (0.9, -1.0, 0.1), "back": (0.0, 1.0, 0.1),
-    "low": (0.7, -1.0, 0.35),
+    "low": (0.7, -1.0, 0.35), "top": (0.6, 0.6, 0.9),
 }  # fmt: skip
 
 
@@ -79,7 +88,7 @@ def main() -> None:
     out = Path(args.out)
     chars = []
     chosen = SETS[args.set]
-    heads = args.set == "heads"
+    heads = args.set in ("heads", "hair")
     spacing, tall, aim = FRAMING.get(args.set, (SPACING if heads else 0.55, 1.0, None))
     for i, (params, names) in enumerate(chosen):
         human = Human(params).dressed(*names)  # stands on its shoes' soles

@@ -160,3 +160,28 @@ def test_jacket_leather_is_satin_not_glittery_plastic():
 def test_facial_hair_specs_default_to_following_the_hair():
     for name in library.FOLLOWS_HAIR:
         assert name in builtin.BY_NAME
+
+
+@pytest.mark.parametrize("style", ["hair-short", "hair-bob"])
+def test_scalp_hair_greys_with_age_as_the_brows_do(style):
+    """An old wearer's built-in hair is salt and pepper to grey on the brows' age curve; a
+    young one's keeps its colour; a colour the user picked is kept at any age."""
+    young = _worn([style, "eyebrows"], 0.4)
+    sixties = _worn([style, "eyebrows"], 0.75)
+    old = _worn([style, "eyebrows"], 0.95)
+    own = load_garment(style, texture_size=128).material
+    assert young[style] is own  # untouched below the greying age
+    lumas = [_shown_luma(m[style]) for m in (young, sixties, old)]
+    assert lumas[0] < lumas[1] < lumas[2] and lumas[2] > 4 * lumas[0]
+    # Grey strands, not a grey wash: shown texels are either the hair's colour or grey.
+    tex = old[style].base_color_texture
+    lin = facial_hair._linear(tex[..., :3])
+    shown = tex[..., 3] > 127
+    chroma = (lin.max(-1) - lin.min(-1))[shown] / np.maximum(lin.max(-1)[shown], 1e-4)
+    assert (chroma < 0.12).mean() > 0.6 and (chroma > 0.3).mean() > 0.03
+    brows = [_shown_luma(m["eyebrows"]) for m in (young, old)]
+    assert brows[1] > 3 * brows[0]  # the brows grey alongside
+    picked = {"colour": "auburn hair"}
+    dyed = load_garment(style, texture_size=128, options=picked)
+    kept = library.wearer_looks([dyed], [style], {style: picked}, 0.95)[0]
+    assert kept.material is dyed.material

@@ -224,7 +224,8 @@ def dress(
     """Fit garments (Garment records, or names/paths: ``load_garment``) on a shaped body
     (``Human.body``); see ``fitting.dress``. options: {entry: a built-in's variant}.
     age: the wearer's MakeHuman age; given, the built-in brows and facial hair follow the
-    wearer (``wearer_looks``): the built-in scalp hair's colour, greying with age."""
+    wearer (``wearer_looks``): the built-in scalp hair's colour, greying with age; the
+    built-in scalp hair greys too unless a colour option was picked for it."""
     options = options or {}
     loaded = [
         g if isinstance(g, Garment)
@@ -250,7 +251,9 @@ def wearer_looks(
 ) -> list[Garment]:
     """``loaded`` with the built-in brows and facial hair recoloured for the wearer: the
     colour of the built-in scalp hair worn (its variant's, else its own) unless the item
-    has a colour option of its own, greying with ``age`` (``facial_hair.for_wearer``)."""
+    has a colour option of its own, greying with ``age`` (``facial_hair.for_wearer``);
+    the built-in scalp hair itself greys on the same curve (salt and pepper in the
+    sixties, mostly grey at 90) unless a colour was picked for it."""
     hair = None
     for name in names:
         spec = builtin.BY_NAME.get(name)
@@ -258,15 +261,28 @@ def wearer_looks(
             hair = str(options.get(name, {}).get("colour", spec.colour))
     out = []
     for garment, name in zip(loaded, names, strict=True):
+        own = options.get(name, {}).get("colour")
         kind = FOLLOWS_HAIR.get(name) or KEEPS_COLOUR.get(name)
+        scalp = kind is None and _greys(name, own, age)
+        if scalp:
+            kind = "cards"  # built-in scalp hair: its own colour, greying with age
         if kind is None:
             out.append(garment)
             continue
-        own = options.get(name, {}).get("colour")
-        colour = None if (own or name in KEEPS_COLOUR) else hair
+        colour = None if (own or name in KEEPS_COLOUR or scalp) else hair
         look = _wearer_material(garment, kind, round(float(age), 2), colour)
         out.append(replace(garment, material=look))
     return out
+
+
+def _greys(name: str, own_colour: object, age: float) -> bool:
+    """Whether a worn item is built-in scalp hair that greys at ``age``: not when the user
+    picked its colour (a dyed grey-free head is a choice), nor before greying starts."""
+    from avatar.looks import facial_hair
+
+    spec = builtin.BY_NAME.get(name)
+    return (spec is not None and spec.category == "hair" and not own_colour
+            and facial_hair.grey_share(age) > 0)  # fmt: skip
 
 
 _WEARER: dict[tuple, tuple[Material, Material]] = {}

@@ -175,8 +175,9 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
     """``material`` of a brow or facial-hair built-in recoloured for its wearer.
 
     kind: "brows" (``textures.hair_material``'s brow shade of ``colour``), "cards" (beard,
-    moustache: strand cards) or "stubble". age: MakeHuman's age (0..1): grey strands mix in
-    from ``GREY_FROM`` (``grey_share``), and a child's brows are fainter and lighter.
+    moustache, scalp hair: strand cards) or "stubble". age: MakeHuman's age (0..1):
+    grey strands mix in from ``GREY_FROM`` (``grey_share``), and a child's brows are
+    fainter and lighter.
     colour: the wearer's hair colour (a name or linear RGB), or None to keep the
     material's own. Returns a new Material (the texture's alpha is kept, but for a
     child's brows)."""
@@ -189,12 +190,7 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
             rgb = rgb * textures.brow_shade(rgb)
         elif kind == "stubble":
             rgb = rgb * 0.7
-        shade = np.ones(size, np.float32)
-        if kind == "cards":  # keep the strands' shading from the material's own colour
-            own = _linear(tex[..., :3]).mean(-1)
-            shown = own[tex[..., 3] > 127]
-            shade = own / max(float(np.median(shown)) if shown.size else 1.0, 1e-4)
-        lin = rgb[None, None, :] * shade[..., None]
+        lin = rgb[None, None, :] * _strand_shade(tex, kind)[..., None]
     else:
         lin = _linear(tex[..., :3])
     share = grey_share(age)
@@ -205,7 +201,9 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         else:
             grey = rng.uniform(size=size) < share
         white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey
-        lin = np.where(grey[..., None], white[None, None, :], lin)
+        # Grey strands keep the card's strand shading (a flat grey reads as paint).
+        white = white[None, None, :] * _strand_shade(tex, kind)[..., None]
+        lin = np.where(grey[..., None], white, lin)
     alpha = tex[..., 3]
     if kind == "brows" and age < 0.3:  # a child's brows: fine, fair, faint
         young = float(np.clip((0.3 - age) / 0.3, 0, 1))
@@ -213,6 +211,16 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         alpha = np.round(alpha * (1 - 0.35 * young)).astype(np.uint8)
     out = np.concatenate([fabrics.srgb(lin), alpha[..., None]], -1)
     return replace(material, base_color_texture=np.ascontiguousarray(out))
+
+
+def _strand_shade(tex: np.ndarray, kind: str) -> np.ndarray:
+    """(H, W) float32 the strand shading of a strand-card texture (each texel's luminance
+    over the median shown one), so a recolouring keeps its strands; ones for other kinds."""
+    if kind != "cards":
+        return np.ones(tex.shape[:2], np.float32)
+    own = _linear(tex[..., :3]).mean(-1)
+    shown = own[tex[..., 3] > 127]
+    return own / max(float(np.median(shown)) if shown.size else 1.0, 1e-4)
 
 
 def _linear(srgb_u8: np.ndarray) -> np.ndarray:
