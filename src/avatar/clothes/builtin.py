@@ -93,15 +93,16 @@ def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
 
 
 def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
-              thread: str) -> Piece:  # fmt: skip
+              thread: str, taper: float = 0.9) -> Piece:  # fmt: skip
     """Jeans or trousers: cut from ``helper-tights`` to ``length`` along the leg, falling
-    straight from the knee (``hang`` x the knee's radius), unrolled into four panels
+    straight from the knee (``hang`` x the knee's radius, narrowing to ``taper`` x that at
+    the ankle: ``tailoring.straight_legs``), unrolled into four panels
     painted with ``kind``'s construction (``tailoring``), a raised waistband and hem bands,
     and belt loops."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     mesh = cut(body, faces, bottom(length)(ff, body.marks), ease, relax=RELAX)
-    mesh = Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang)
+    mesh = Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang, taper=taper)
                 .astype(np.float32), mesh.faces)  # fmt: skip
     panels = tailoring.Panels(mesh, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
     band = 0.04 if kind == "jeans" else 0.035
@@ -480,8 +481,8 @@ SPECS = [
     Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
-    Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.08, "grey"), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
-    Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow"), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
+    Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
+    Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow", 0.92), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
     Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
     Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",), clearance=0.006),  # noqa: E501
