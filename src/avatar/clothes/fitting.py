@@ -305,7 +305,7 @@ def _dress(
         if qo is not None:
             mesh = _check_outer(pose, mesh, anchor, qo)
             fitted[-1] = replace(fitted[-1], mesh=mesh)
-    return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy(), body_weights)
+    return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
 
 
 def _anchor_on_default_body(body: Body, garments: list[Garment]) -> None:

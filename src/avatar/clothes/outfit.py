@@ -17,6 +17,7 @@ import numpy as np
 from avatar.body.model import BODY_VERTICES
 from avatar.clothes.contacts import REMOTE_K, remote_contacts
 from avatar.geometry import collision
+from avatar.geometry.nearest import PointTree
 from avatar.rig.skinning import SkinWeights, linear_blend
 
 if TYPE_CHECKING:
@@ -37,7 +38,6 @@ class Outfit:
     # skin vertex at rest.
     anchors: list[tuple[np.ndarray, ...] | None] = field(default_factory=list)
     rest_body: np.ndarray | None = None  # (13380, 3) skin at rest, to tell remote contacts
-    body_weights: SkinWeights | None = None  # the body's skin weights (rigid groups)
 
     # An Outfit reads as the list of its FittedGarments.
     def __iter__(self):
@@ -208,31 +208,27 @@ class _FrameLayout:
         )
 
 
-FIRM = 0.99  # weight on one bone above which a vertex all but moves with that bone
-RIGID_POINTS = 1000  # fewest such garment points on one bone worth leaving out
-CLEAR = 0.01  # m: other skin further than this beyond a point's REMOTE_K-th nearest is no contact
-STILL = 2e-4  # m a firm vertex may move in its bone's frame and still count as unmoved
+RIGID_POINTS = 1000  # fewest garment points moving mostly with one bone worth the shortcut
+CLEAR = 0.01  # m: skin further than this beyond a point's REMOTE_K-th nearest is no contact
+STILL = 2e-4  # m a vertex may move in a bone's frame and still count as unmoved
 
 
 @dataclass(frozen=True, eq=False)
 class _RigidPoints:
-    """Garment points that move with one bone, as does the skin round them (short hair on
-    the head: ~9,000 card vertices, most of a frame's remote-contact search). Where that
-    skin and the point have moved less than STILL in the bone's frame, and skin moving
-    otherwise (the neck under the head) has not come near, the point sits on the skin as
-    at rest and the search can leave it out; the full search would move it at most 2 STILL
-    (0.4 mm; clearances are millimetres). "Near" is measured in the bone's frame: a point
-    is left out while its rest distance to the nearest skin vertex not firm on the bone,
-    less how far the worst such vertex within reach moved (a hand raised to the head moves
-    far and brings every point back in), exceeds its rest distance to its REMOTE_K-th
-    nearest skin vertex plus CLEAR."""
+    """Garment points that move with one bone, as the skin round them does (short hair on
+    the head: ~9,000 card vertices, most of a frame's remote-contact search). Where such
+    a point and all skin within its reach (its REMOTE_K-th nearest skin vertex at rest, plus
+    CLEAR) have moved less than STILL in the bone's frame, the skin round it is as at rest,
+    so the point sits on it as at rest and the search can leave it out: the full search
+    would move it at most about 2 STILL (0.4 mm; clearances are millimetres). Skin that
+    moved (the neck under a nodding head, a hand raised to the hair) is found in the bone's
+    frame, and only points it has come within reach of are searched."""
 
     count: int  # remote-contact rows
     bones: list[int]
     rows: list[np.ndarray]  # per bone: (P,) remote rows of the points it moves most
-    rest_points: list[np.ndarray]  # per bone: (P, 3) their rest positions
-    slack: list[np.ndarray]  # per bone: (P,) m the soft skin may close in
-    firm: list[np.ndarray]  # per bone: (V,) bool skin vertices firm on it
+    rest_points: list[np.ndarray]  # per bone: (P, 3) float32 their rest positions
+    reach: list[np.ndarray]  # per bone: (P,) float32 m within which moved skin matters
     box: list[np.ndarray]  # per bone: (2, 3) the points' rest box, grown by their reach
     rest: np.ndarray  # (V, 3) float32 the rest skin
 
@@ -243,31 +239,25 @@ class _RigidPoints:
         skin = np.zeros((0, 3), np.float32)
         if outfit.rest_body is not None:
             skin = np.asarray(outfit.rest_body[:BODY_VERTICES], np.float32)
-        found = cls(len(lay.remote_order), [], [], [], [], [], [], skin)
+        found = cls(len(lay.remote_order), [], [], [], [], [], skin)
         # Inner-layer rows only (a shell's outer layer also follows the skin's normals).
         at = np.flatnonzero(lay.remote_order < len(lay.colliding))
-        inner = lay.colliding[lay.remote_order[at]]
-        if outfit.body_weights is None or len(skin) == 0 or len(inner) == 0:
+        if len(skin) == 0 or len(at) == 0:
             return found
-        skin_bone, skin_weight = _top_bone(outfit.body_weights, len(skin))
-        point_bone, point_weight = _top_bone(lay.weights, len(lay.rest))
-        point_bone = np.where(point_weight[inner] >= 0.5, point_bone[inner], -1)
-        points = lay.rest[inner]
-        own = cKDTree(skin).query(points, k=REMOTE_K)[0][:, -1]
-        for bone in np.unique(point_bone[point_bone >= 0]):
-            rows = np.flatnonzero(point_bone == bone)
-            firm = (skin_bone == bone) & (skin_weight >= FIRM)
-            if len(rows) < RIGID_POINTS or firm.all():
+        inner = lay.colliding[lay.remote_order[at]]
+        bone_of = _top_bone(lay.weights, inner)
+        points = lay.rest[inner].astype(np.float32)
+        reach = cKDTree(skin).query(points, k=REMOTE_K)[0][:, -1] + CLEAR
+        for bone in np.unique(bone_of[bone_of >= 0]):
+            rows = np.flatnonzero(bone_of == bone)
+            if len(rows) < RIGID_POINTS:
                 continue
-            reach = own[rows] + CLEAR
-            slack = cKDTree(skin[~firm]).query(points[rows])[0] - reach
-            grow = reach.max()
+            grow = reach[rows].max()
             box = np.stack([points[rows].min(0) - grow, points[rows].max(0) + grow])
             found.bones.append(int(bone))
             found.rows.append(at[rows])
             found.rest_points.append(points[rows])
-            found.slack.append(slack.astype(np.float32))
-            found.firm.append(firm)
+            found.reach.append(reach[rows].astype(np.float32))
             found.box.append(box.astype(np.float32))
         return found
 
@@ -275,30 +265,28 @@ class _RigidPoints:
         """(count,) bool: the remote rows to search in this pose (skin (V, 3) and the
         remote-contact points (count, 3) posed by the skinning matrices (J, 4, 4))."""
         check = np.ones(self.count, bool)
-        for bone, rows, rest_points, slack, firm, box in zip(
-            self.bones, self.rows, self.rest_points, self.slack, self.firm, self.box,
-            strict=True,
-        ):  # fmt: skip
+        for bone, rows, rest_points, reach, box in zip(
+            self.bones, self.rows, self.rest_points, self.reach, self.box, strict=True
+        ):
             back = np.linalg.inv(matrices[bone]).astype(np.float32)  # posed -> the bone's rest
             local = skin @ back[:3, :3].T + back[:3, 3]
-            near = _inside(local, box)
-            moved = _lengths(local[near] - self.rest[near])
-            if moved[firm[near]].max(initial=0.0) > STILL:
-                continue  # the skin under the points itself moved: search them all
-            drift = moved[~firm[near]].max(initial=0.0)
-            own = _lengths(points[rows] @ back[:3, :3].T + back[:3, 3] - rest_points)
-            apart = (slack > drift) | (drift <= STILL)
-            check[rows[apart & (own <= STILL)]] = False
+            near = _inside(local, box)  # skin further out is beyond every point's reach
+            moved = near[_lengths(local[near] - self.rest[near]) > STILL]
+            own = points[rows] @ back[:3, :3].T + back[:3, 3] - rest_points
+            still = np.flatnonzero(_lengths(own) <= STILL)
+            if len(moved) and len(still):
+                gap, _ = PointTree(local[moved]).query(rest_points[still], reach=float(reach.max()))
+                still = still[gap > reach[still]]
+            check[rows[still]] = False
         return check
 
 
-def _top_bone(weights: SkinWeights, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """(count,) the bone with the largest weight on each of the first ``count`` vertices,
-    and that weight."""
-    w, idx = weights.weights[:count], weights.indices[:count]
+def _top_bone(weights: SkinWeights, rows: np.ndarray) -> np.ndarray:
+    """(R,) the bone that moves each of the vertices ``rows`` most (at least half), else -1."""
+    w, idx = weights.weights[rows], weights.indices[rows]
     top = np.argmax(w, axis=1)
-    rows = np.arange(count)
-    return idx[rows, top], w[rows, top]
+    at = np.arange(len(rows))
+    return np.where(w[at, top] >= 0.5, idx[at, top], -1)
 
 
 def _inside(points: np.ndarray, box: np.ndarray) -> np.ndarray:
