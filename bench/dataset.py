@@ -6,7 +6,8 @@
    the same scenes (same people, camera, lights; RGB only), on one worker in-process;
 2. workers: 1 -> 2 local worker processes, each rendering on its share of the cores
    (efficiency = rate(2) / (2 * rate(1)), the single worker on one core's share, as each
-   of the two has), and the speed-up of 2 workers over 1 worker on every core;
+   of the two has: its threads limited and the process held to that many cores), and the
+   speed-up of 2 workers over 1 worker on every core;
 3. engines: local vs Ray (a local cluster), same samples;
 4. --rss N: the worker's resident memory over N samples (one process, no recycling), the
    curve printed every 10 samples: it should stay within 10% of its value after 50.
@@ -62,14 +63,20 @@ def rate(args, workers: int, engine: str, folder: Path, threads: int | None = No
     the runner's share of the cores)."""
     c = _config(args, args.count)
     shares = runner.render_threads
+    cores = os.sched_getaffinity(0)
     if threads is not None:  # the parent decides the workers' threads: set it there
         runner.render_threads = lambda workers, cores=None: threads  # type: ignore[assignment]
+        # ... and on that many cores only (workers inherit it): the anchor worker's numpy
+        # and OpenMP searches would otherwise also use the core the other worker has.
+        os.sched_setaffinity(0, sorted(cores)[:threads])
     shutil.rmtree(folder, ignore_errors=True)
     start = time.perf_counter()
     try:
-        report = runner.run(c, folder, workers=workers, engine=engine)
+        with runner.thread_limits(threads or 0):
+            report = runner.run(c, folder, workers=workers, engine=engine)
     finally:
         runner.render_threads = shares  # type: ignore[assignment]
+        os.sched_setaffinity(0, cores)
     assert not report.failed, report.failed
     return args.count / (time.perf_counter() - start)
 

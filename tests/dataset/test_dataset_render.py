@@ -216,6 +216,35 @@ def test_workers_share_the_cores_out_among_their_renders():
     assert runner.render_threads(4, cores=2) == 1  # never zero threads
 
 
+def _child_threads() -> dict:
+    import os
+
+    from pykdtree.kdtree import KDTree  # noqa: F401  (its OpenMP pool starts with the import)
+
+    return {name: os.environ.get(name) for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+
+
+def test_spawned_workers_get_their_share_of_native_threads(monkeypatch):
+    """Each worker's OpenMP (pykdtree) and OpenBLAS pools are limited as its Cycles is, in
+    a real spawned process; the parent's environment is put back, a user's value kept."""
+    import multiprocessing
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from avatar.dataset import runner
+
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")  # the user's choice
+    with runner.thread_limits(1):
+        pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+        with pool:
+            seen = pool.submit(_child_threads).result(timeout=120)
+    assert seen == {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "3"}
+    assert "OMP_NUM_THREADS" not in os.environ and os.environ["OPENBLAS_NUM_THREADS"] == "3"
+    with runner.thread_limits(0):  # one worker: no limit
+        assert "OMP_NUM_THREADS" not in os.environ
+
+
 @pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="needs Ray (the ray extra)")
 def test_ray_cluster_on_loopback_renders_the_same_samples(dataset, tmp_path):
     """A real local Ray cluster (`ray start --head` on 127.0.0.1): the same label bytes as

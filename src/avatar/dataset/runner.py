@@ -14,8 +14,9 @@ import os
 import sys
 import tempfile
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -112,6 +113,12 @@ Result = tuple[int, dict | None, str | None]  # (index, manifest entry, error)
 def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable[Result]:
     """Render ``todo`` on ``workers`` processes, yielding results as they finish."""
     threads = render_threads(workers)
+    with thread_limits(threads):  # workers start (and restart) while the pool runs
+        yield from _pooled(config, out, todo, workers, threads)
+
+
+def _pooled(config: Config, out: Path, todo: list[int], workers: int,
+            threads: int) -> Iterable[Result]:  # fmt: skip
     context = multiprocessing.get_context("spawn")  # a fresh Blender per worker
     pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=context,
                                max_tasks_per_child=config.render.recycle_every)  # fmt: skip
@@ -131,6 +138,33 @@ def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable
                     yield index, None, f"worker failed: {exc.__class__.__name__}: {exc}"
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+# Native thread pools a worker's libraries start with one thread per core unless told.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextmanager
+def thread_limits(threads: int) -> Iterator[None]:
+    """Spawned workers limited to ``threads`` native threads each (OpenMP: pykdtree's
+    searches; OpenBLAS/MKL: numpy), as their Cycles is: otherwise every worker's OpenMP
+    pool has a thread per core, spinning after each search, and two workers on two cores
+    take time from each other's renders. The variables are read when a library loads, so
+    they are set in this process's environment, which spawned workers inherit, for as long
+    as the pool may start workers (it restarts them after ``recycle_every`` samples); a
+    value the user set is kept. 0: no limit (one worker)."""
+    saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
+    if threads > 0:
+        for name in THREAD_VARIABLES:
+            os.environ.setdefault(name, str(threads))
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
 
 
 def render_threads(workers: int, cores: int | None = None) -> int:
