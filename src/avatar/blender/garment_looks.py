@@ -19,7 +19,8 @@ import bpy
 
 from avatar.blender import live
 from avatar.blender import materials as material_bridge
-from avatar.clothes import builtin, library, variants
+from avatar.body.model import BodyModel
+from avatar.clothes import library, variants
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
 
@@ -31,20 +32,17 @@ def options_of(root: bpy.types.Object) -> dict[str, dict[str, str]]:
 
 def apply(root: bpy.types.Object) -> int:
     """Give each worn built-in garment of ``root``'s character the material of its variant
-    (or its own when it has none); returns how many materials were swapped."""
+    (or its own when it has none), brows, facial hair and hair aged for the wearer
+    (``live.worn_looks``); returns how many materials were swapped. A user's .mhclo keeps
+    the material it was made with (and is not read again here)."""
     recipe = live.recipe_of(root)
     parts = live.part_objects(root)
     swapped = 0
-    for entry in recipe.clothes:
-        source = library.find_garment(entry, recipe.folders)
-        if source not in builtin.BY_NAME:  # only built-ins have variants; a user's .mhclo
-            continue  # keeps the material it was made with (and is not read again here)
-        garment = library.load_garment(source, recipe.folders,
-                                       options=recipe.garment_options.get(entry))  # fmt: skip
-        obj = parts.get(garment.name)
-        if obj is None or obj.type != "MESH" or garment.material is None:
+    for name, look in live.worn_looks(recipe, BodyModel.shared()).items():
+        obj = parts.get(name)
+        if obj is None or obj.type != "MESH":
             continue
-        swapped += _swap(obj, material_bridge.material(garment.material, garment.name))
+        swapped += _swap(obj, material_bridge.material(look, name))
     return swapped
 
 
@@ -72,13 +70,10 @@ def set_options(root: bpy.types.Object, entry: str, options: Mapping[str, str | 
     new = Recipe.from_dict({**recipe.to_dict(), "garment_options": new_options})
     Human.from_recipe(new)  # the whole recipe still realises
     garment = library.load_garment(source, recipe.folders, options=checked)
-    parts = live.part_objects(root)
-    obj = parts.get(garment.name)
-    if obj is None:
+    if garment.name not in live.part_objects(root):
         raise AvatarError(f"{root.name} has no {garment.name!r} object to recolour")
-    material = material_bridge.material(garment.material, garment.name)
     root[live.RECIPE_KEY] = json.dumps(new.to_dict())
-    _swap(obj, material)
+    apply(root)  # it, aged for the wearer, and the brows and beard that follow a hair colour
     return checked
 
 

@@ -44,6 +44,7 @@ from avatar.clothes.binding import fit
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
+from avatar.material import Material
 from avatar.mesh import Mesh
 from avatar.part import MeshPart
 
@@ -224,10 +225,28 @@ def _parts(human: Human, geo: Geometry) -> list[tuple[MeshPart, Mesh]]:
         mesh = _body_mesh(geo) if part == "body" else human.part(part)
         out.append((MeshPart(part, mesh, _body_material(human, part),
                              (skin.indices, skin.weights)), mesh))  # fmt: skip
+    looks = worn_looks(human.recipe, human.model) if geo.outfit else {}
     for fitted in geo.outfit or ():
         part = library.garment_part(fitted)
+        if fitted.name in looks:  # its variant, aged for the wearer, as Human.outfit has it
+            part = MeshPart(part.name, part.mesh, looks[fitted.name], part.skin)
         out.append((part, part.mesh))
     return out
+
+
+def worn_looks(recipe: Recipe, model: BodyModel) -> dict[str, Material]:
+    """{garment name: its Material} of the recipe's worn built-ins, as ``Human.outfit``
+    dresses them: the fabric/colour variant of ``garment_options``, brows and facial hair
+    in the hair's colour and the built-in hair and brows greying with the wearer's age
+    (``library.wearer_looks``). User garments keep the material they were made with."""
+    entries = [e for e in recipe.clothes if library.find_garment(e, recipe.folders)
+               in builtin.BY_NAME]  # fmt: skip
+    options = recipe.garment_options
+    loaded = [library.load_garment(e, recipe.folders, model=model, options=options.get(e))
+              for e in entries]  # fmt: skip
+    age = (model.defaults() | recipe.params)["age"]
+    worn = library.wearer_looks(loaded, entries, options, age)
+    return {g.name: g.material for g in worn if g.material is not None}
 
 
 def _body_mesh(geo: Geometry) -> Mesh:
@@ -407,12 +426,17 @@ def settle(root: bpy.types.Object) -> Geometry:
 
 def refresh_materials(root: bpy.types.Object, human: Human) -> None:
     """Give the body and eyes the materials ``human``'s parameters make (the skin depends
-    on ethnicity, age and gender); the old ones go when nothing else uses them."""
+    on ethnicity, age and gender), and the worn built-ins theirs (``worn_looks``: brows,
+    facial hair and hair grey with age); the old ones go when nothing else uses them."""
     parts = part_objects(root)
     for name in PART_GROUPS:
         obj = parts.get(name)
         if obj is not None:
             _swap_material(obj, material_bridge.material(human.material(name), name))
+    for name, look in worn_looks(human.recipe, human.model).items():
+        obj = parts.get(name)
+        if obj is not None and obj.type == "MESH":
+            _swap_material(obj, material_bridge.material(look, name))
 
 
 def _swap_material(obj: bpy.types.Object, new: bpy.types.Material) -> None:

@@ -251,4 +251,46 @@ def cap(body: AuthoringBody) -> Piece:
     return Piece(piece.mesh, piece.binding, layout)
 
 
-__all__ = ["brim", "button", "cap", "cap_marks", "crown", "rim_height"]
+# Hair under the crown keeps between the fitting's clearance and HAIR_UNDER off the scalp:
+# the crown's inside is EASE out, and the fitting stacks a garment LAYER_GAP (1.5 mm) over
+# the highest layer below it, so hair standing higher would push the whole cap up off the
+# head (it sat 1.5 cm high over short hair).
+HAIR_UNDER = 0.004
+HAIR_FLOOR = 0.002  # m: fitting.CLEARANCE, the least any hair keeps off the skin
+PRESS_BELOW = (0.025, 0.05)  # m below the rim: pressed fully down to, back to its own by
+
+
+def pressed_hair(body: AuthoringBody, hair: Piece) -> Piece:
+    """Scalp hair as it lies under the cap: every point under the crown, and down to
+    ``PRESS_BELOW[0]`` under its rim (the band's skin), flattened along the skin's normal
+    into ``HAIR_FLOOR``..``HAIR_UNDER`` off the scalp (a soft squash: the highest layers
+    come down most, the order of layers is kept), easing back to the hair's own height by
+    ``PRESS_BELOW[1]`` below the rim, so it shows below the band at the back and sides.
+    Rebound to the skin. Heights are the fitting's: distances to the closest point of the
+    skin's surface (a nearest vertex's tangent plane reads the sparse crown several
+    millimetres low)."""
+    from avatar.geometry import collision
+
+    centre, eye_z, _ = _frame(body)
+    v = hair.mesh.vertices.astype(np.float64)
+    rel = v - centre
+    below = rim_height(np.arctan2(rel[:, 0], -rel[:, 1]), eye_z) - v[:, 2]
+    t = np.clip((below - PRESS_BELOW[0]) / (PRESS_BELOW[1] - PRESS_BELOW[0]), 0, 1)
+    press = 1 - t * t * (3 - 2 * t)  # 1 under the crown, 0 from PRESS_BELOW[1] down
+    base = body.base
+    surface = collision.skin_surface(base.faces[base.face_groups["body"]])
+    skin = body.vertices[:BODY_VERTICES]
+    room = HAIR_UNDER - HAIR_FLOOR
+    wanted = None
+    for _ in range(2):  # the closest point moves a little as the hair comes down
+        q = collision.query(skin, surface, v, k=4)
+        off = q.distance.astype(np.float64)
+        if wanted is None:  # each point's pressed height, from its own height
+            squashed = HAIR_FLOOR + room * np.tanh(np.maximum(off - HAIR_FLOOR, 0) / room)
+            wanted = np.minimum(off, press * squashed + (1 - press) * off)
+        v = v + np.minimum(wanted - off, 0)[:, None] * q.normal
+    mesh = Mesh(v.astype(np.float32), hair.mesh.faces, hair.mesh.uvs, hair.mesh.face_uvs)
+    return bound(body, mesh, body.skin_faces)
+
+
+__all__ = ["brim", "button", "cap", "cap_marks", "crown", "pressed_hair", "rim_height"]

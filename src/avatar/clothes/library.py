@@ -28,7 +28,6 @@ from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.clothes.scan import LibraryEntry, scan
 from avatar.clothes.scan import entry as scan_entry
 from avatar.errors import AvatarError, unknown_name
-from avatar.material import Material
 from avatar.part import MeshPart
 
 ENV_PATH = "AVATAR_CLOTHES_PATH"
@@ -232,10 +231,51 @@ def dress(
         else load_garment(g, folders, model=body.model, options=options.get(str(g)))
         for g in garments
     ]
+    names = [str(g) if not isinstance(g, Garment) else g.name for g in garments]
+    loaded = under_headwear(loaded, names, body.model)
     if age is not None:
-        loaded = wearer_looks(loaded, [str(g) if not isinstance(g, Garment) else g.name
-                                       for g in garments], options, age)  # fmt: skip
+        loaded = wearer_looks(loaded, names, options, age)
     return fitting.dress(body, loaded, exact)
+
+
+def under_headwear(loaded: list[Garment], names: list[str],
+                   model: BodyModel | None = None) -> list[Garment]:  # fmt: skip
+    """``loaded`` with the built-in scalp hair pressed under a built-in cap when one is worn
+    (``headwear.pressed_hair``), so the cap sits on the head and the hair shows below its
+    band; anything else as it is."""
+    capped = any(builtin.BY_NAME[n].category == "headwear" for n in names if n in builtin.BY_NAME)
+    if not capped:
+        return loaded
+    out = []
+    for garment, name in zip(loaded, names, strict=True):
+        spec = builtin.BY_NAME.get(name)
+        out.append(_pressed(garment, name, model) if spec and spec.category == "hair"
+                   else garment)  # fmt: skip
+    return out
+
+
+_PRESSED: dict[int, tuple[Garment, Garment]] = {}
+
+
+def _pressed(garment: Garment, name: str, model: BodyModel | None) -> Garment:
+    """A built-in hair garment (its variant's material kept) with the pressed geometry,
+    made once per garment record (its fitting anchors then stay cached with it)."""
+    hit = _PRESSED.get(id(garment))
+    if hit is not None and hit[0] is garment:
+        return hit[1]
+    piece = _pressed_piece(name, model)
+    out = replace(garment, mesh=piece.mesh, binding=piece.binding)
+    if len(_PRESSED) > 32:
+        _PRESSED.clear()
+    _PRESSED[id(garment)] = (garment, out)
+    return out
+
+
+@lru_cache(maxsize=8)
+def _pressed_piece(name: str, model: BodyModel | None):
+    from avatar.clothes import headwear
+
+    return headwear.pressed_hair(authoring_body(model), _piece(name, model))
 
 
 # Built-ins that follow their wearer's hair colour and age, and how (``for_wearer``'s kind);
@@ -270,8 +310,7 @@ def wearer_looks(
             out.append(garment)
             continue
         colour = None if (own or name in KEEPS_COLOUR or scalp) else hair
-        look = _wearer_material(garment, kind, round(float(age), 2), colour)
-        out.append(replace(garment, material=look))
+        out.append(_wearer_garment(garment, kind, round(float(age), 2), colour))
     return out
 
 
@@ -285,26 +324,26 @@ def _greys(name: str, own_colour: object, age: float) -> bool:
             and facial_hair.grey_share(age) > 0)  # fmt: skip
 
 
-_WEARER: dict[tuple, tuple[Material, Material]] = {}
+_WEARER: dict[tuple, tuple[Garment, Garment]] = {}
 
 
-def _wearer_material(
-    garment: Garment, kind: str, age: float, colour: str | None
-) -> Material | None:
-    """``facial_hair.for_wearer`` of a garment's material, remembered (a few dozen)."""
+def _wearer_garment(garment: Garment, kind: str, age: float, colour: str | None) -> Garment:
+    """The garment with ``facial_hair.for_wearer`` of its material, remembered (a few
+    dozen): the same record for the same wearer, so its fitting anchors are found once."""
     from avatar.looks import facial_hair
 
     if garment.material is None:
-        return None
-    key = (id(garment.material), kind, age, colour)
+        return garment
+    key = (id(garment), kind, age, colour)
     hit = _WEARER.get(key)
-    if hit is not None and hit[0] is garment.material:
+    if hit is not None and hit[0] is garment:
         return hit[1]
     if len(_WEARER) > 64:
         _WEARER.clear()
     look = facial_hair.for_wearer(garment.material, kind, age, colour)
-    _WEARER[key] = (garment.material, look)
-    return look
+    out = replace(garment, material=look)
+    _WEARER[key] = (garment, out)
+    return out
 
 
 def parts(outfit: Outfit) -> list[MeshPart]:
