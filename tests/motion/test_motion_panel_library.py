@@ -21,15 +21,9 @@ needs_clips = pytest.mark.skipif(not WALK.is_file(), reason="needs the CMU BVH f
 
 
 @pytest.fixture(scope="module")
-def human():
-    from avatar.body import assets
-    from avatar.errors import AssetError
+def human(assets):
     from avatar.human import Human
 
-    try:
-        assets.find_data_dir()
-    except AssetError as exc:
-        pytest.skip(f"MakeHuman assets not installed: {exc}")
     return Human({})
 
 
