@@ -63,3 +63,73 @@ def test_trouser_legs_fall_straight_and_do_not_bell_mid_stride(name, params):
         assert np.percentile(hem_walk, 95) < 1.25 * knee_r, (tag, hem_walk.max(), knee_r)
         # Still a trouser leg, not a legging: well clear of the ankle.
         assert hem_rest > 0.85 * knee_r
+
+
+# ---------------------------------------------------------------------------- shoes
+
+
+def _luminance(srgb: np.ndarray) -> np.ndarray:
+    c = srgb[..., :3].astype(np.float64) / 255
+    c = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return c @ [0.2126, 0.7152, 0.0722]
+
+
+def _texels(material, mesh, corners: np.ndarray) -> np.ndarray:
+    """(N, 3) base colour texels under the UVs of mesh corners (N,) (face_uvs entries)."""
+    image = material.base_color_texture
+    size = image.shape[0]
+    uv = mesh.uvs[corners]
+    rows = np.clip(((1 - uv[:, 1]) * size).astype(int), 0, size - 1)
+    cols = np.clip((uv[:, 0] * size).astype(int), 0, size - 1)
+    return image[rows, cols]
+
+
+@pytest.mark.parametrize("name", ["shoes", "shoes-black"])
+def test_leather_shoes_laces_and_stitches_are_not_white_dashes(name):
+    """On brown and black leather shoes the laces and the welt/cap stitching are in the
+    leather's hue: cream laces and near-white stitch dashes read as white dashes on the
+    instep. Sampled from the built material under the laces' own UVs."""
+    from avatar.clothes import builtin, library, shoes
+
+    body = library.authoring_body()
+    garment = builtin.build(builtin.BY_NAME[name], body, 256)
+    mesh, material = garment.mesh, garment.material
+    v0, v1 = shoes.ROWS["laces"]
+    corner_v = mesh.uvs[mesh.face_uvs.ravel(), 1]
+    laces = mesh.face_uvs.ravel()[(corner_v >= v0) & (corner_v < v1)]
+    upper = mesh.face_uvs.ravel()[corner_v >= shoes.ROWS["upper"][0]]
+    lace_l = np.median(_luminance(_texels(material, mesh, laces)))
+    upper_l = np.median(_luminance(_texels(material, mesh, upper)))
+    assert lace_l < 1.5 * upper_l + 0.01, (lace_l, upper_l)
+    # No near-white texel anywhere on leather or laces (stitches included).
+    image = material.base_color_texture
+    leather = image[: int(round((1 - shoes.ROWS["cap"][0]) * image.shape[0]))]
+    assert np.percentile(_luminance(leather), 99.9) < 0.45
+
+
+def test_low_shoes_end_below_the_ankle_bones_and_boots_above():
+    """A low shoe's top line runs under the ankle bones at the sides and at a heel
+    counter's height behind (it was cut level 11 cm up, over the ankle joint: an ankle
+    boot); the ankle boot still covers the ankle."""
+    from avatar.clothes import library, shoes
+    from avatar.geometry.shell import boundary_edges
+
+    body = library.authoring_body()
+    for side in (0, 1):
+        foot = shoes.Foot(body, side)
+        for top, boot in ((0.96, False), (0.86, True)):
+            mesh = shoes.upper(body, foot, top).mesh
+            rim = np.unique(boundary_edges(mesh.faces)[0])
+            rim = rim[mesh.vertices[rim, 2] > foot.ground + 0.03]  # the opening, not the sole's
+            height = mesh.vertices[rim, 2] - foot.ground
+            along = foot.along(mesh.vertices[rim])
+            sides = (along > 0.15) & (along < 0.35)
+            heel = along < 0.08
+            ankle = foot.ankle[2] - foot.ground
+            if boot:
+                assert height.min() > ankle + 0.01
+            else:
+                assert sides.any() and heel.any()
+                assert np.median(height[sides]) < ankle - 0.015, (height[sides], ankle)
+                assert np.median(height[heel]) < ankle
+                assert np.median(height[heel]) > np.median(height[sides])  # a heel counter

@@ -489,7 +489,7 @@ SPECS = [
     Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",), clearance=0.005),
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
-    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "cream", "dark brown")),  # noqa: E501
+    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "dark brown", "dark brown")),  # noqa: E501
     Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "black", "black", "charcoal")),  # noqa: E501
     Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", "white", "grey")),  # noqa: E501
     Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "black", "tan", "dark brown")),  # noqa: E501

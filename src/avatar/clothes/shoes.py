@@ -52,14 +52,26 @@ class Foot:
         return (self.heel_y - p[..., 1]) / (self.heel_y - self.toe_y)
 
 
+# A low shoe's top line (m above the ground) along the foot (0 heel, 1 toes): the heel
+# counter, dipping under the ankle bones at the sides, rising to the throat of the lacing
+# over the instep; the vamp in front is all kept. Measured on oxfords and derbies.
+TOPLINE = ((0.0, 0.12, 0.28, 0.4, 0.5), (0.066, 0.062, 0.048, 0.062, 0.09))
+LOW = 0.9  # ``top`` above this along the leg: a low shoe (below the ankle), cut to TOPLINE
+
+
 def _shoe_faces(body: AuthoringBody, foot: Foot, faces: np.ndarray,
                 top: float = 0.96) -> np.ndarray:  # fmt: skip
     """(F,) bool: helper-tights faces of one foot and its ankle, the bottom left open for
-    the sole (faces within 1.5 cm of the ground and facing down or out low)."""
+    the sole (faces within 1.5 cm of the ground and facing down or out low). A low shoe
+    (``top`` > LOW) ends at TOPLINE, under the ankle bones: cut level round the ankle it
+    read as an ankle boot (a collar 11 cm high, over the ankle joint)."""
     ff = regions.face_features(body.vertices, faces, body.part, body.marks)
     side = np.sign(ff.centre[:, 0]) == (1 if foot.side == 0 else -1)
     shoe = (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > top))
     low = ff.centre[:, 2] < foot.ground + 0.012
+    if top > LOW:
+        line = np.interp(foot.along(ff.centre), *TOPLINE)
+        shoe &= ff.centre[:, 2] < foot.ground + line
     return shoe & side & ~low
 
 

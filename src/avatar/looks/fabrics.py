@@ -238,7 +238,8 @@ def atlas(
     """One Material whose texture is cut in horizontal bands, each its own fabric and colour:
     ``rows`` of (v0, v1, fabric, colour) with v in [0, 1] (v up). For garments made of
     several materials (a shoe's leather, sole rubber and laces) that must stay one part.
-    stitches: v heights where a dashed seam of light thread is drawn across the texture.
+    stitches: v heights where a dashed seam of thread a few shades lighter than the
+    leather (tan on brown, grey on black) is drawn across the texture.
     """
     colour = np.zeros((size, size, 3), np.uint8)
     normal = np.zeros((size, size, 3), np.uint8)
@@ -251,8 +252,9 @@ def atlas(
     for v in stitches:  # dashes 6 px long, 2 px thick, a thread's height in the normal map
         row = int(round((1 - v) * size))
         dash = (np.arange(size) // 6) % 2 == 0
-        colour[row : row + 2, dash] = (np.asarray(colour[row : row + 2, dash], np.float32) * 0.4
-                                       + 150).astype(np.uint8)  # fmt: skip
+        # A thread in the leather's own hue (near-white dashes read as laces from afar).
+        colour[row : row + 2, dash] = np.clip(np.asarray(colour[row : row + 2, dash], np.float32)
+                                              * 1.5 + 25, 0, 255).astype(np.uint8)  # fmt: skip
         normal[row, dash] = (128, 170, 230)
         normal[row + 1, dash] = (128, 86, 230)
     return Material(
