@@ -133,3 +133,29 @@ def test_low_shoes_end_below_the_ankle_bones_and_boots_above():
                 assert np.median(height[sides]) < ankle - 0.015, (height[sides], ankle)
                 assert np.median(height[heel]) < ankle
                 assert np.median(height[heel]) > np.median(height[sides])  # a heel counter
+
+
+# ---------------------------------------------------------------------------- cap
+
+
+def test_cap_brim_is_a_visor_in_front_not_a_bucket():
+    """The brim reaches forward from the forehead as wide as the head, curving down a
+    little at its sides: reaching out radially round the crown it stood 2.7 cm past each
+    side of the head (a bucket hat's brim). On two heads."""
+    from avatar.body.model import BODY_VERTICES
+    from avatar.clothes import headwear
+    from avatar.clothes.authoring import AuthoringBody
+
+    for params in (ELDERLY_MAN, {"gender": 0.5, "age": 0.15}):
+        body = AuthoringBody(Human(params).body)
+        crown, rim = headwear.crown(body)
+        v = headwear.brim(body, crown, rim).vertices.astype(np.float64)
+        head = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"]
+        centre, eye_z, _ = headwear._frame(body)
+        half_width = np.abs(head[:, 0]).max()
+        assert np.abs(v[:, 0]).max() < half_width  # no wider than the head
+        assert v[:, 1].max() < centre[1] - 0.025  # all in front, well ahead of the ears
+        assert v[:, 1].min() < head[:, 1].min() - 0.05  # still a visor's reach
+        # A flat-ish pre-curved plate: its edge drops at most 2.5 cm from middle to sides.
+        edge = v[v[:, 1] < v[:, 1].min() + 0.01]
+        assert np.ptp(v[:, 2]) < 0.045 and np.ptp(edge[:, 2]) < 0.025

@@ -29,7 +29,7 @@ MERIDIANS = 72  # around the crown (a multiple of GORES: seams fall on meridians
 RINGS = 16  # from the rim up to the button
 BRIM_REACH = 0.075  # m the brim stands out in front
 BRIM_THICK = 0.004
-BRIM_SPAN = 70.0  # degrees either side of the front the brim is attached over
+BRIM_SPAN = 68.0  # degrees either side of the front the brim is attached over (temple to temple)
 UV_PER_METRE = 2.0  # the cap's texture: roughly 0.5 m of cloth across it
 
 
@@ -152,7 +152,10 @@ def button(body: AuthoringBody, mesh: Mesh, radius: float = 0.008) -> Mesh:
 
 def brim(body: AuthoringBody, crown_mesh: Mesh, rim: np.ndarray) -> Mesh:
     """The visor: a plate BRIM_THICK thick attached along the crown's front rim, reaching
-    BRIM_REACH forward, curved down towards its sides, its outer edge a rounded half tube."""
+    forward (not out round the head: a brim reaching out radially stood 2.7 cm past each
+    side of the head, a bucket's), BRIM_REACH at the middle, its outline a rounded D as
+    wide as the crown's front, curved down towards its sides, its outer edge a rounded
+    half tube."""
     v = crown_mesh.vertices.astype(np.float64)
     centre, eye_z, _ = _frame(body)
     rel = v[rim] - centre
@@ -160,22 +163,28 @@ def brim(body: AuthoringBody, crown_mesh: Mesh, rim: np.ndarray) -> Mesh:
     order = np.argsort(phi)
     front = order[np.abs(phi[order]) < np.radians(BRIM_SPAN)]
     inner = v[rim][front] + [0, 0, -0.002]
-    p = phi[front]
-    out = np.stack([np.sin(p), -np.cos(p), np.zeros(len(p))], -1)
-    # Reach: most at the front, tapering to nothing at the ends (a rounded D outline).
-    reach = BRIM_REACH * np.sqrt(np.clip(1 - (p / np.radians(BRIM_SPAN)) ** 2, 0, 1))
-    steps = np.linspace(0, 1, 8)
     x_half = float(np.abs(inner[:, 0]).max())
+    # The outline in plan: BRIM_REACH ahead of the rim's middle, rounding back to the
+    # rim at the ends (a squarish D); each rim point reaches straight forward to it.
+    forward = np.array([0.0, -1.0, 0.0])
+    nose = float(inner[np.argmin(np.abs(inner[:, 0])), 1])
+    outline = nose - BRIM_REACH * np.clip(1 - (inner[:, 0] / x_half) ** 2, 0, 1) ** 0.35
+    reach = np.clip(inner[:, 1] - outline, 0, None)
+    steps = np.linspace(0, 1, 8)
     rows = []
     for t in steps:  # from the crown out to the edge
-        pt = inner + (reach * t)[:, None] * out
+        pt = inner + (reach * t)[:, None] * forward
         # Curved down at the sides (pre-bent), tipped a little down at the front.
-        pt[:, 2] -= 0.022 * (pt[:, 0] / x_half) ** 2 * t + 0.01 * t**1.5
+        pt[:, 2] -= 0.018 * (pt[:, 0] / x_half) ** 2 * t + 0.01 * t**1.5
         rows.append(pt)
     top_rows = np.stack(rows)  # (R, N, 3)
     bottom_rows = top_rows - [0, 0, BRIM_THICK]
-    # The outer edge: a half tube from the top sheet round to the bottom sheet.
-    edge_out = out
+    # The outer edge: a half tube from the top sheet round to the bottom sheet, bulging
+    # out square to the outline in plan.
+    tangent = np.gradient(top_rows[-1][:, :2], axis=0)
+    edge_out = np.column_stack([-tangent[:, 1], tangent[:, 0], np.zeros(len(tangent))])
+    edge_out /= np.maximum(np.linalg.norm(edge_out, axis=1, keepdims=True), 1e-12)
+    edge_out *= np.where(edge_out[:, 1] > 0, -1.0, 1.0)[:, None]  # away from the head
     arc = []
     for a in np.linspace(0, np.pi, 6)[1:-1]:
         arc.append(top_rows[-1] + edge_out * (BRIM_THICK / 2) * np.sin(a)
