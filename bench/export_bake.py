@@ -2,14 +2,16 @@
 
     .venv/bin/python bench/export_bake.py [--seconds 10] [--fps 30] [--wear tshirt,jeans,...]
     .venv/bin/python bench/export_bake.py --clip CLIP.bvh   # e.g. CMU 01_01 (2,752 frames)
+    .venv/bin/python bench/export_bake.py --clip CLIP.bvh --frames 1000:1500   # an excerpt
 
 One dressed body (the default human, game_engine rig), the built-in walk or a BVH clip
 retargeted onto it. In the same run: the plain skinned GLB (``resolve_garments=False``) and
-the baked one (a few correction shapes per garment driven by per-frame weights,
-``avatar.clothes.bake``): export time, the bake's time per frame (``Outfit.frame(exact=True)``
-alone as the anchor), file sizes, correction shapes per garment, and the worst garment
-penetration played back from each file (morphs blended with the keyed weights, then the
-file's skin and animation: what a viewer shows). Prints a table for docs/benchmarks.md.
+the baked one (a few correction shapes per garment and segment of the clip driven by
+per-frame weights, ``avatar.clothes.bake``): export time, the bake's time per frame
+(``Outfit.frame(exact=True)`` alone as the anchor), file sizes, correction shapes per
+garment, and the worst garment penetration played back from each file (morphs blended with
+the keyed weights, then the file's skin and animation: what a viewer shows). Prints a table
+for docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -26,6 +28,17 @@ WEAR = "tshirt,jeans,shoes,hair-short"
 
 def _arg(argv: list[str], name: str, default: str) -> str:
     return argv[argv.index(name) + 1] if name in argv else default
+
+
+def _excerpt(clip, frames: str):
+    """(the clip's frames ``start:stop[:step]``, a label for them); all without ``frames``."""
+    from dataclasses import replace
+
+    if not frames:
+        return clip, ""
+    rows = slice(*(int(x) if x else None for x in frames.split(":")))
+    excerpt = replace(clip, rotations=clip.rotations[rows], translations=clip.translations[rows])
+    return excerpt, f" frames {frames}"
 
 
 def _frame_anchor(human, clip, frames: int) -> float:
@@ -78,6 +91,7 @@ def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
 
 def main(argv: list[str]) -> None:
     import avatar
+    from avatar.clothes import bake
     from avatar.human import BODY_PART_GROUPS
 
     seconds, fps = float(_arg(argv, "--seconds", "10")), float(_arg(argv, "--fps", "30"))
@@ -86,7 +100,8 @@ def main(argv: list[str]) -> None:
     if "--clip" in argv:
         source = Path(_arg(argv, "--clip", ""))
         clip, _ = human.retarget(*avatar.load_bvh(source))
-        label = f"{source.stem}: {clip.frames} frames at {clip.fps:g} fps"
+        clip, excerpt = _excerpt(clip, _arg(argv, "--frames", ""))
+        label = f"{source.stem}{excerpt}: {clip.frames} frames at {clip.fps:g} fps"
     else:
         clip = human.walk(seconds=seconds, fps=fps)
         label = f"walk: {clip.frames} frames ({seconds:g} s at {fps:g} fps)"
@@ -117,7 +132,8 @@ def main(argv: list[str]) -> None:
           f"{per_frame / anchor:.2f}x {exact} |")  # fmt: skip
     print(f"| GLB size | {plain_b / 1e6:.2f} MB | {baked_b / 1e6:.2f} MB | "
           f"{baked_b / plain_b:.2f}x |")  # fmt: skip
-    print(f"| correction shapes (incl. offset) | 0 | "
+    segments = len(bake.segments(clip.frames))
+    print(f"| correction shapes (incl. offsets; {segments} segments) | 0 | "
           f"{', '.join(f'{k} {v}' for k, v in shapes.items())} | |")  # fmt: skip
     print(f"| worst garment depth inside the body, played back | {plain_in[0] * 1e3:.1f} mm | "
           f"{baked_in[0] * 1e3:.1f} mm | |")  # fmt: skip

@@ -13,20 +13,33 @@ Compact form. The per-frame deltas of one garment, stacked as X (T, 3U) over the
 that ever move, are close to low-rank (the same folds at elbows, knees, hips recur), so each
 garment gets a small basis: the principal components of X (no centring: a frame without
 correction has weights 0), the fewest k <= ``MAX_BASIS`` (16) whose reconstruction leaves
-no vertex of any frame more than ``ERROR_BOUND`` (0.5 mm) from its exact delta. The file
-holds those k morph targets ``correction_00``.. per garment (plus ``correction_offset``,
-held at 1, so that every weight lies in [0, 1], the range players keep) and a (T, k + 1)
-weights channel: it grows linearly with the clip (k + 1 weights a frame), not with its
-square. Because A is a blend of rotations (its norm is at most 1), a bind-space error e
-moves the played-back vertex by at most e.
+no vertex of any frame more than ``ERROR_BOUND`` (0.5 mm) from its exact delta. Because A is
+a blend of rotations (its norm is at most 1), a bind-space error e moves the played-back
+vertex by at most e.
 
-Long, varied clips (CMU's jumps) are not low-rank at that bound: 16 shapes leave centimetres
-between some frames and their exact resolves. Those errors matter only where they go into
-the body, and the exact resolve is only one way out of it; so the bake then plays every frame
-back as a viewer will (``REFINE_PASSES`` checks): vertices more than ``ERROR_BOUND`` inside
-the skin are pushed out (``MARGIN`` beyond it), the frame's weights are solved again with
-them weighted ``HEAVY``, and (the first ``REFITS`` checks) the shapes are refitted to the mended
-frames, which are low-rank by construction. What is left is measured in docs/benchmarks.md.
+Segments. A long clip is not low-rank (CMU's jumps: 16 shapes leave 2 cm over 2,752 frames),
+so it is cut into equal windows of at most ``SEGMENT`` (300) frames (``segments``), each with
+its own basis, fitted and checked on its frames alone. The file holds per garment and
+segment s the morph targets ``correction_s<s>_offset`` (held at 1, so that every weight lies
+in [0, 1], the range players keep) and ``correction_s<s>_00``.., and one (T, targets) weights
+channel in which a segment's targets are 0 outside its frames: the file grows linearly with
+the clip (a segment's shapes and n x its targets weights), and one segment's shapes play at
+a time. Windows switch hard at a frame: the weights are keyed with STEP interpolation, each
+frame plays its own correction exactly, so a cross-fade would only ask two bases to hold the
+same frames. A clip of at most ``SEGMENT`` frames is one segment, as it was before segments.
+
+Play-back checks. Within a segment, 16 shapes still miss the exact resolves of a jump by
+millimetres; those errors matter only where they go into the body, and the exact resolve
+is only one way out of it. So the bake plays every frame back as a viewer will
+(``REFINE_PASSES`` checks): vertices more than ``ERROR_BOUND`` inside the skin are pushed
+out (``MARGIN`` beyond it). The first ``REFITS`` checks solve the frame's weights again with
+them weighted ``HEAVY`` and refit the shapes to the mended frames (low-rank by
+construction); the later ones give the frames they mend a few sparse shapes of their own
+that play the push-outs (``_grow``, at most ``GROW`` a check), which converges: only those
+frames change, so only those are checked again. A check measures only vertices that can be
+that deep: the distance to the skin changes at most as much as the point moves, so a
+played-back vertex closer to its exact position than that position's clearance (+ bound) is
+skipped. What is left is measured in docs/benchmarks.md.
 
     parts, weights = bake(human.body, human.outfit, animation, human.parts())
     gltf.write(path, parts, human.skeleton, {"walk": animation}, morph_weights={"walk": weights})
@@ -35,7 +48,7 @@ frames, which are low-rank by construction. What is left is measured in docs/ben
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 from functools import partial
 
@@ -54,16 +67,19 @@ from avatar.rig.skeleton import Animation
 log = logging.getLogger(__name__)
 
 TOLERANCE = 5e-5  # m; smaller corrections are left out (the targets stay sparse)
-CHUNK = 256  # frames whose bone matrices are computed together
 SINGULAR = 1e-6  # |det A| below which a vertex's blended matrix is inverted by pseudo-inverse
 ERROR_BOUND = 5e-4  # m: worst distance of a played-back garment vertex from its exact frame
-MAX_BASIS = 16  # correction shapes a garment gets when they meet ERROR_BOUND (the usual case)
+MAX_BASIS = 16  # correction shapes a garment segment gets (fewer when they meet ERROR_BOUND)
+SEGMENT = 300  # most frames one basis holds: longer clips are cut into equal windows
+GROW = 8  # most shapes a late check adds to a segment's basis for the frames it mended
+GROW_BOUND = 1e-4  # m: how closely those shapes play the mended frames' push-outs
 LIMIT = 64  # most shapes a garment gets when ERROR_BOUND needs more than MAX_BASIS
 BASIS_PREFIX = "correction_"
 REFINE_PASSES = 12  # play-back checks; each pushes out what went inside (stops when none did)
 REFITS = 6  # the first checks that also refit the shapes to the mended frames
 MARGIN = 1.5e-3  # m: how far outside the skin a check puts a vertex it pushes out
 HEAVY = 100.0  # weight of pushed-out vertices in a frame's least-squares weights
+SLACK = 2e-4  # m: checks measure vertices this near their bound (the skin query is approximate)
 
 
 SkinOf = Callable[[MeshPart, int], skinning.SkinWeights]  # (part, joint count) -> its skin
@@ -78,8 +94,9 @@ def bake(
     skin: SkinOf | None = None,
     max_influences: int = MAX_INFLUENCES,
     bound: float = ERROR_BOUND,
+    segment: int = SEGMENT,
 ) -> tuple[list[MeshPart], dict[str, np.ndarray]]:
-    """Add each garment's correction basis (a few morph targets) to the garment parts.
+    """Add each garment's correction bases (a few morph targets a segment) to the garment parts.
 
     body: the shaped body; outfit: the garments fitted on it (``Human.outfit``).
     parts: the parts to export (``Human.parts(...)``): its last ``len(outfit)`` parts are
@@ -89,40 +106,39 @@ def bake(
     skin: the weights the player will skin with (default ``file_skin`` with
         ``max_influences``, a glTF viewer's; ``vertex_group_skin`` for Blender's Armature).
     bound: the largest distance (m) a played-back vertex may be from its exact frame.
-    Returns the parts (garments with extra morphs ``correction_offset``, ``correction_00``..
-    after any they had;
-    deltas (M, 3) float32 metres in bind space) and part name -> (T, targets) float32 morph
-    weights (0 for the morphs they had before), for garments that need a correction.
+    segment: the most frames one basis holds (``segments``).
+    Returns the parts (garments with extra morphs ``correction_s00_offset``,
+    ``correction_s00_00``.. after any they had; deltas (M, 3) float32 metres in bind space)
+    and part name -> (T, targets) float32 morph weights (0 for the morphs they had before,
+    and for a segment's morphs outside its frames), for garments that need a correction.
     """
+    from tqdm import tqdm
+
     garments = _garment_parts(parts, outfit)
     joints = len(body.skeleton.names)
     skin_of = skin or partial(file_skin, limit=max_influences)
-    skins = [skin_of(p, joints) for p in garments]
-    corrections = [Corrections(len(p.mesh.vertices), animation.frames) for p in garments]
-    for t, posed, matrices in _frames(body, animation, progress):
-        resolved = outfit.frame(posed, matrices, exact=True)
-        for i, part in enumerate(garments):
-            delta = bind_correction(part.mesh.vertices, skins[i], matrices, resolved[i])
-            if delta is not None:
-                corrections[i].add(t, delta)
-    bases = [fit(c, bound) for c in corrections]
-    collide = [g.garment.collide for g in outfit.garments]
-    heavy: list[dict[int, np.ndarray]] = [{} for _ in garments]  # t -> pushed vertices
-    for step in range(REFINE_PASSES):
-        if not _played_back_fixes(body, animation, garments, skins, corrections, bases, collide,
-                                  heavy, bound):  # fmt: skip
-            break
-        if step < REFITS:  # refit the shapes to the mended frames, then the weights
-            bases = [fit(c, bound) for c in corrections]
-            for i, basis in enumerate(bases):
-                if basis is None:
-                    continue
-                for t, pushed in heavy[i].items():
-                    _solve_weights(basis, corrections[i], t, pushed)
-    pairs = zip(garments, corrections, bases, strict=True)
-    baked = [_with_basis(p, c, b, bound) for p, c, b in pairs]
+    faces = body.model.base.faces[body.model.base.face_groups["body"]]
+    job = _Job(body, outfit, garments, [skin_of(p, joints) for p in garments],
+               [g.garment.collide for g in outfit.garments], collision.body_surface(faces),
+               bound)  # fmt: skip
+    windows = segments(animation.frames, segment)
+    with tqdm(total=animation.frames, desc="resolving garments", unit="frame",
+              disable=not progress, leave=False) as bar:  # fmt: skip
+        per_window = [job.settle(job.resolve(animation, w, bar)) for w in windows]
+    baked = [_with_bases(part, windows, [b[i] for b in per_window], bound, animation.frames)
+             for i, part in enumerate(garments)]  # fmt: skip
     out = parts[: len(parts) - len(garments)] + [part for part, _ in baked]
     return out, {part.name: w for part, w in baked if w is not None}
+
+
+def segments(frames: int, length: int = SEGMENT) -> list[range]:
+    """The clip's frames cut into the fewest equal windows of at most ``length`` frames
+    (a clip of up to ``length`` frames is one window), in order, covering 0..frames-1."""
+    if length < 1:
+        raise AvatarError(f"segment length {length}: use at least 1 frame")
+    count = max(1, -(-frames // length))
+    edges = np.linspace(0, frames, count + 1).round().astype(int)
+    return [range(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
 
 
 @dataclass
@@ -149,19 +165,192 @@ class Corrections:
 
 @dataclass(frozen=True)
 class Basis:
-    """A garment's compact correction: shapes (k, U, 3) over vertices ``moved`` (U,),
-    weights (T, k), and the worst per-vertex reconstruction error (m)."""
+    """A garment's compact correction over one segment: shapes (k, U, 3) over vertices
+    ``moved`` (U,), weights (n, k) for the segment's n frames, and the worst per-vertex
+    reconstruction error (m)."""
 
     moved: np.ndarray
     shapes: np.ndarray
     weights: np.ndarray
     error: float
 
+    def moved_delta(self, t: int) -> np.ndarray:
+        """(U, 3) float64 bind-space correction of the moved vertices at segment frame t."""
+        return np.einsum("k,kvc->vc", self.weights[t].astype(np.float64), self.shapes)
+
     def delta(self, t: int, vertices: int) -> np.ndarray:
-        """(vertices, 3) float64 bind-space correction this basis plays at frame t."""
+        """(vertices, 3) float64 bind-space correction this basis plays at segment frame t."""
         out = np.zeros((vertices, 3))
-        out[self.moved] = np.einsum("k,kvc->vc", self.weights[t], self.shapes)
+        out[self.moved] = self.moved_delta(t)
         return out
+
+
+@dataclass
+class _Window:
+    """One segment's frames as the bake needs them again after resolving them: skinned body
+    (n, BODY_VERTICES, 3) float32, skinning matrices (n, J, 4, 4), per garment its exact
+    frames (n, M, 3) float32, their signed distances to the skin (n, M) float32 (NaN until
+    a check needs them), and its corrections."""
+
+    bodies: np.ndarray
+    matrices: np.ndarray
+    exact: list[np.ndarray]
+    clearance: list[np.ndarray]
+    corrections: list[Corrections]
+
+
+@dataclass
+class _Job:
+    """The fixed inputs of one bake: body, outfit, the garment parts with the skins the
+    player uses, which garments collide with the body, the body's surface and the bound."""
+
+    body: Body
+    outfit: Outfit
+    garments: list[MeshPart]
+    skins: list[skinning.SkinWeights]
+    collide: list[bool]
+    surface: collision.BodySurface
+    bound: float
+
+    def resolve(self, animation: Animation, window: range, bar) -> _Window:
+        """Every frame of ``window`` resolved exactly (``Outfit.frame(exact=True)``) and turned
+        into bind-space corrections (``bind_correction``)."""
+        skeleton = self.body.skeleton
+        rows = slice(window.start, window.stop)
+        world = kinematics.forward(
+            skeleton, animation.rotations[rows], animation.translations[rows]
+        )
+        matrices = kinematics.skinning_matrices(skeleton, world)
+        n = len(window)
+        sizes = [len(p.mesh.vertices) for p in self.garments]
+        out = _Window(np.empty((n, BODY_VERTICES, 3), np.float32), matrices,
+                      [np.empty((n, m, 3), np.float32) for m in sizes],
+                      [np.full((n, m), np.nan, np.float32) for m in sizes],
+                      [Corrections(m, n) for m in sizes])  # fmt: skip
+        for t in range(n):
+            posed = skinning.linear_blend(self.body.vertices, self.body.weights, matrices[t])
+            out.bodies[t] = posed[:BODY_VERTICES]
+            resolved = self.outfit.frame(posed, matrices[t], exact=True)
+            for i, part in enumerate(self.garments):
+                out.exact[i][t] = resolved[i]
+                delta = bind_correction(part.mesh.vertices, self.skins[i], matrices[t], resolved[i])
+                if delta is not None:
+                    out.corrections[i].add(t, delta)
+            bar.update()
+        return out
+
+    def settle(self, window: _Window) -> list[Basis | None]:
+        """Each garment's basis of the window, played back and mended (``check``) until no
+        vertex is more than ``bound`` inside the skin or ``REFINE_PASSES`` checks ran.
+
+        The first ``REFITS`` checks re-solve the weights of the frames they mend and refit
+        the shapes to the mended frames (every frame is then checked again); the later ones
+        add the mended frames' push-outs as a few sparse shapes of their own (``_grow``),
+        which only those frames play, so only those are checked again.
+        """
+        bases = [fit(c, self.bound) for c in window.corrections]
+        heavy: list[dict[int, np.ndarray]] = [{} for _ in self.garments]  # t -> pushed vertices
+        frames: Iterable[int] = range(len(window.bodies))
+        for step in range(REFINE_PASSES):
+            refit = step < REFITS
+            mended = self.check(window, bases, heavy, frames, solve=refit)
+            if not any(mended):
+                break
+            if refit:
+                pairs = zip(window.corrections, heavy, strict=True)
+                bases = [_refit(c, self.bound, h) for c, h in pairs]
+                frames = range(len(window.bodies))
+            else:
+                bases = [
+                    b if b is None or not m else _grow(b, c, sorted(m))
+                    for b, c, m in zip(bases, window.corrections, mended, strict=True)
+                ]
+                frames = sorted(set().union(*mended))
+        return bases
+
+    def check(self, window: _Window, bases: list[Basis | None], heavy: list[dict],
+              frames: Iterable[int], solve: bool) -> list[set[int]]:  # fmt: skip
+        """Play ``frames`` back as the file will (each basis, the player's skin); where a
+        garment vertex lands more than ``bound`` inside the skin, make that frame's target
+        the played frame with those vertices pushed out (MARGIN outside) and solve the
+        frame's weights again (``solve``) with them ``HEAVY`` (``_solve_weights``); a refit
+        of the shapes carries them. Returns the frames it mended, per garment.
+
+        The exact resolves are one way out of the body among many: the played-back frame, a
+        low-rank one, mended only where it goes in, is as valid and far easier for the basis
+        to hold (corrections of long clips are not low-rank at ERROR_BOUND). ``heavy``: per
+        garment, t -> the vertices pushed at frame t so far (updated).
+        """
+        mended: list[set[int]] = [set() for _ in bases]
+        pushed = 0
+        played = [self._played(b, i) for i, b in enumerate(bases)]
+        for t in frames:
+            skin = None
+            for i, play in enumerate(played):
+                if play is None:
+                    continue
+                basis, points, sub = play(t, window.matrices[t])
+                suspect = self._suspects(window, i, t, basis.moved, points)
+                if not len(suspect):
+                    continue
+                skin = skin or collision.PosedBody(self.surface, window.bodies[t])
+                deep, out = self._deep(window, i, t, basis.moved, points, suspect, skin)
+                if not len(deep):
+                    continue
+                target = np.asarray(points, dtype=np.float64)
+                target[deep] = out
+                rest = self.garments[i].mesh.vertices
+                part = bind_correction(rest[basis.moved], sub, window.matrices[t], target)
+                if part is None:
+                    continue
+                delta = np.zeros((len(rest), 3), np.float32)
+                delta[basis.moved] = part
+                window.corrections[i].add(t, delta)
+                heavy[i][t] = np.union1d(heavy[i].get(t, np.zeros(0, np.int64)), basis.moved[deep])
+                if solve:
+                    _solve_weights(basis, window.corrections[i], t, heavy[i][t])
+                mended[i].add(t)
+                pushed += len(deep)
+        log.info("played-back check: %d garment vertex-frames pushed out", pushed)
+        return mended
+
+    def _played(self, basis: Basis | None, i: int):
+        """t, matrices -> (basis, played moved vertices (U, 3) float32, their skin), or None
+        when garment i has nothing to check."""
+        if basis is None or not len(basis.shapes) or not self.collide[i]:
+            return None
+        moved = basis.moved
+        rest = self.garments[i].mesh.vertices[moved].astype(np.float64)
+        sub = skinning.SkinWeights(self.skins[i].indices[moved], self.skins[i].weights[moved])
+
+        def play(t: int, matrices: np.ndarray):
+            return basis, skinning.linear_blend(rest + basis.moved_delta(t), sub, matrices), sub
+
+        return play
+
+    def _suspects(self, window: _Window, i: int, t: int, moved: np.ndarray,
+                  points: np.ndarray) -> np.ndarray:  # fmt: skip
+        """Rows of ``moved`` whose played positions may be more than ``bound`` inside: the
+        signed distance to the skin moves at most as far as the point does, so a point
+        within (clearance of the exact point + bound - SLACK) of it cannot be that deep.
+        NaN clearance (not yet measured) makes a row a suspect."""
+        gap = np.linalg.norm(points - window.exact[i][t, moved], axis=1)
+        return np.flatnonzero(~(gap <= window.clearance[i][t, moved] + self.bound - SLACK))
+
+    def _deep(self, window: _Window, i: int, t: int, moved: np.ndarray, points: np.ndarray,
+              suspect: np.ndarray, skin: collision.PosedBody):  # fmt: skip
+        """(rows of ``moved`` more than ``bound`` inside, the skin query of those rows),"""
+        clearance = window.clearance[i][t]
+        unknown = suspect[np.isnan(clearance[moved[suspect]])]
+        if len(unknown):
+            exact = window.exact[i][t, moved[unknown]]
+            clearance[moved[unknown]] = skin.query(exact, k=6).distance
+            suspect = self._suspects(window, i, t, moved, points)
+        if not len(suspect):
+            return suspect, np.zeros((0, 3), np.float32)
+        q = skin.query(points[suspect], k=6)
+        deep = np.flatnonzero(q.distance < -self.bound)
+        return suspect[deep], q.closest[deep] + MARGIN * q.normal[deep]
 
 
 def _solve_weights(basis: Basis, corrections: Corrections, t: int, pushed: np.ndarray) -> None:
@@ -185,6 +374,33 @@ def _solve_weights(basis: Basis, corrections: Corrections, t: int, pushed: np.nd
     basis.weights[t] = np.linalg.lstsq(lhs, rhs, rcond=None)[0].astype(np.float32)
 
 
+def _refit(corrections: Corrections, bound: float, heavy: dict[int, np.ndarray]) -> Basis | None:
+    """``fit`` to the mended frames, then their weights solved with their pushed vertices
+    ``HEAVY``."""
+    basis = fit(corrections, bound)
+    for t, rows in heavy.items():
+        if basis is not None:
+            _solve_weights(basis, corrections, t, rows)
+    return basis
+
+
+def _grow(basis: Basis, corrections: Corrections, frames: list[int]) -> Basis:
+    """The basis with a few more shapes that play what ``frames`` miss of their targets
+    (the push-outs a check made: sparse, a few vertices each), weighted on those frames
+    only: the principal shapes of those residuals, at most ``GROW`` a call, within
+    ``GROW_BOUND``."""
+    residual = np.zeros((len(frames), len(basis.moved), 3), dtype=np.float32)
+    for r, t in enumerate(frames):
+        at = np.searchsorted(basis.moved, corrections.rows[t])
+        residual[r, at] = corrections.deltas[t]
+        residual[r] -= basis.moved_delta(t)
+    shapes, weights, _ = fit_basis(residual, GROW_BOUND, GROW)
+    out = np.zeros((len(basis.weights), len(basis.shapes) + len(shapes)), dtype=np.float32)
+    out[:, : len(basis.shapes)] = basis.weights
+    out[frames, len(basis.shapes) :] = weights
+    return Basis(basis.moved, np.concatenate([basis.shapes, shapes]), out, basis.error)
+
+
 def fit(corrections: Corrections, bound: float = ERROR_BOUND) -> Basis | None:
     """The compact basis of one garment's corrections (``fit_basis``), None without any."""
     if not corrections.rows:
@@ -192,51 +408,6 @@ def fit(corrections: Corrections, bound: float = ERROR_BOUND) -> Basis | None:
     moved, x = corrections.matrix()
     shapes, weights, error = fit_basis(x, bound, MAX_BASIS)
     return Basis(moved, shapes, weights, error)
-
-
-def _played_back_fixes(body, animation, garments, skins, corrections, bases, collide, heavy,
-                       bound: float) -> int:  # fmt: skip
-    """Play every frame back as the file will (each basis, the file's skin); where a garment
-    vertex lands more than ``bound`` inside the skin, make that frame's target the played
-    frame with those vertices pushed out (MARGIN outside) and solve the frame's weights again
-    with those vertices ``HEAVY`` (``_solve_weights``); a refit of the shapes carries them.
-
-    The exact resolves are one way out of the body among many: the played-back frame, a
-    low-rank one, mended only where it goes in, is as valid and far easier for the basis to
-    hold (corrections of long clips are not low-rank at ERROR_BOUND). ``heavy``: per garment,
-    t -> the vertices pushed at frame t so far (updated). Returns how many vertex-frames
-    were pushed out.
-    """
-    faces = body.model.base.faces[body.model.base.face_groups["body"]]
-    surface = collision.body_surface(faces)
-    fixed = 0
-    for t, posed, matrices in _frames(body, animation, False):
-        skin = None
-        for i, part in enumerate(garments):
-            if bases[i] is None or not collide[i]:
-                continue
-            rest = part.mesh.vertices.astype(np.float64)
-            played = skinning.linear_blend(rest + bases[i].delta(t, len(rest)), skins[i],
-                                           matrices)  # fmt: skip
-            # Only vertices the basis moves can go in: the others play plain skinning, which
-            # the exact resolve left where it was (outside).
-            moved = bases[i].moved
-            skin = skin or collision.PosedBody(surface, posed[:BODY_VERTICES])
-            q = skin.query(np.asarray(played[moved], dtype=np.float32), k=6)
-            deep = np.flatnonzero(q.distance < -bound)
-            if not len(deep):
-                continue
-            inside = moved[deep]
-            target = np.asarray(played, dtype=np.float64)
-            target[inside] = q.closest[deep] + MARGIN * q.normal[deep]
-            delta = bind_correction(rest, skins[i], matrices, target)
-            if delta is not None:
-                corrections[i].add(t, delta)
-                heavy[i][t] = np.union1d(heavy[i].get(t, np.zeros(0, np.int64)), inside)
-                _solve_weights(bases[i], corrections[i], t, heavy[i][t])
-                fixed += len(inside)
-    log.info("played-back check: %d garment vertex-frames pushed out", fixed)
-    return fixed
 
 
 def fit_basis(x: np.ndarray, bound: float = ERROR_BOUND, limit: int = LIMIT) -> tuple[
@@ -282,36 +453,57 @@ def _principal_directions(flat: np.ndarray, limit: int) -> np.ndarray:
     return vectors[:, keep].T
 
 
-def _with_basis(
-    part: MeshPart, corrections: Corrections, basis: Basis | None, bound: float
-) -> tuple[MeshPart, np.ndarray | None]:
-    """The part with its correction shapes as morphs, and its (T, targets) weights."""
-    if basis is None or not len(basis.shapes):
+def _with_bases(part: MeshPart, windows: list[range], bases: list[Basis | None], bound: float,
+                frames: int) -> tuple[MeshPart, np.ndarray | None]:  # fmt: skip
+    """The part with each segment's correction shapes as morphs, and its (T, targets) weights
+    (a segment's morphs are 0 outside its frames: one segment's shapes play at a time)."""
+    morphs = dict(part.morphs)
+    keyed: list[tuple[range, int, np.ndarray]] = []  # (window, first column, weights)
+    for s, (window, basis) in enumerate(zip(windows, bases, strict=True)):
+        if basis is None or not len(basis.shapes):
+            continue
+        targets, weights = _segment_targets(basis, len(part.mesh.vertices))
+        keyed.append((window, len(morphs), weights))
+        morphs |= {f"{BASIS_PREFIX}s{s:02d}_{name}": d for name, d in targets.items()}
+    if not keyed:
         return part, None
-    moved, shapes, weights, error = basis.moved, basis.shapes, basis.weights, basis.error
-    if len(shapes) > MAX_BASIS or error > bound:
-        log.warning("%s: %d correction shapes, worst error %.2f mm (bound %.2f mm)",
-                    part.name, len(shapes), error * 1e3, bound * 1e3)  # fmt: skip
-    log.info("%s: %d frames corrected -> %d shapes, worst error %.3f mm", part.name,
-             len(corrections.rows), len(shapes), error * 1e3)  # fmt: skip
-    # Weights in [0, 1], which every player keeps (Blender's shape-key sliders and Unity clamp
-    # to it): w = lo + (hi - lo) u, so x = sum lo_k s_k + sum u_k (hi_k - lo_k) s_k, the
-    # first term an "offset" target held at 1 over the clip (the rest mesh is unchanged).
+    _log_bases(part.name, [b for b in bases if b is not None], bound)
+    out = np.zeros((frames, len(morphs)), dtype=np.float32)
+    for window, column, weights in keyed:
+        out[window.start : window.stop, column : column + weights.shape[1]] = weights
+    return replace(part, morphs=morphs), out
+
+
+def _segment_targets(basis: Basis, vertices: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """One segment's morphs (name -> (vertices, 3) float32) and their (n, k + 1) weights.
+
+    Weights in [0, 1], which every player keeps (Blender's shape-key sliders and Unity clamp
+    to it): w = lo + (hi - lo) u, so x = sum lo_k s_k + sum u_k (hi_k - lo_k) s_k, the first
+    term an "offset" target held at 1 over the segment (the rest mesh is unchanged). A shape
+    whose weights reach further below 0 than above is flipped first, so that lo is small and
+    a shape played on a few frames only (``_grow``) stays at 0 on the others."""
+    flip = np.where(-basis.weights.min(axis=0) > basis.weights.max(axis=0), -1.0, 1.0)
+    moved, shapes, weights = basis.moved, basis.shapes * flip[:, None, None], basis.weights * flip
     lo, hi = np.minimum(weights.min(axis=0), 0.0), np.maximum(weights.max(axis=0), 0.0)
     span = np.where(hi - lo > 0, hi - lo, 1.0)
-    morphs = dict(part.morphs)
-    before = len(morphs)
-    offset = np.zeros((corrections.vertices, 3), dtype=np.float32)
-    offset[moved] = np.einsum("k,kvc->vc", lo, shapes)
-    morphs[f"{BASIS_PREFIX}offset"] = offset
+    out = np.ones((len(weights), len(shapes) + 1), dtype=np.float32)
+    out[:, 1:] = np.clip((weights - lo) / span, 0.0, 1.0)
+    morphs = {"offset": np.zeros((vertices, 3), dtype=np.float32)}
+    morphs["offset"][moved] = np.einsum("k,kvc->vc", lo, shapes)
     for k, shape in enumerate(shapes):
-        delta = np.zeros((corrections.vertices, 3), dtype=np.float32)
-        delta[moved] = shape * span[k]
-        morphs[f"{BASIS_PREFIX}{k:02d}"] = delta
-    out = np.zeros((corrections.frames, len(morphs)), dtype=np.float32)
-    out[:, before] = 1.0
-    out[:, before + 1 :] = np.clip((weights - lo) / span, 0.0, 1.0)
-    return replace(part, morphs=morphs), out
+        morphs[f"{k:02d}"] = np.zeros((vertices, 3), dtype=np.float32)
+        morphs[f"{k:02d}"][moved] = shape * span[k]
+    return morphs, out
+
+
+def _log_bases(name: str, bases: list[Basis], bound: float) -> None:
+    """One line a garment: segments, shapes, worst reconstruction error (a warning when a
+    basis misses the bound: the play-back checks then kept it out of the body)."""
+    shapes = sum(len(b.shapes) for b in bases)
+    error = max(b.error for b in bases)
+    level = logging.WARNING if error > bound else logging.INFO
+    log.log(level, "%s: %d segments, %d correction shapes, worst error %.2f mm (bound %.2f mm)",
+            name, len(bases), shapes, error * 1e3, bound * 1e3)  # fmt: skip
 
 
 def file_skin(part: MeshPart, joints: int, limit: int = MAX_INFLUENCES) -> skinning.SkinWeights:
@@ -387,24 +579,3 @@ def _garment_parts(parts: list[MeshPart], outfit) -> list[MeshPart]:
         if part.name != g.name or len(part.mesh.vertices) != len(g.mesh.vertices):
             raise AvatarError(f"part {part.name!r} is not the outfit's garment {g.name!r}")
     return garments
-
-
-def _frames(body: Body, animation: Animation, progress: bool):
-    """(t, body (V, 3), skinning matrices (J, 4, 4)) for every frame of the animation."""
-    from tqdm import tqdm
-
-    bar = tqdm(total=animation.frames, desc="resolving garments", unit="frame",
-               disable=not progress, leave=False)  # fmt: skip
-    with bar:
-        for start in range(0, animation.frames, CHUNK):  # bounded memory on long clips
-            rows = slice(start, start + CHUNK)
-            world = kinematics.forward(
-                body.skeleton, animation.rotations[rows], animation.translations[rows]
-            )
-            for k, matrices in enumerate(kinematics.skinning_matrices(body.skeleton, world)):
-                yield (
-                    start + k,
-                    skinning.linear_blend(body.vertices, body.weights, matrices),
-                    matrices,
-                )
-                bar.update()
