@@ -182,3 +182,60 @@ def test_moustache_tapers_to_the_corners_of_the_mouth(frame):
     # ... and its ends hang down towards the corners of the mouth.
     assert np.median(rel_z[across > 0.75]) < np.median(rel_z[across < 0.3]) - 0.006
     assert np.abs(roots[:, 0]).max() < 1.15 * face.MOUSTACHE_HALF_M
+
+
+def _stubble_uv_metres(body):
+    """The stubble piece's faces (F, 4, 3) and their corners' UVs in atlas metres."""
+    from avatar.looks import facial_hair as fh
+
+    mesh = face.stubble(body).mesh
+    points = mesh.vertices[mesh.faces].astype(np.float64)
+    uv = mesh.uvs[mesh.face_uvs].astype(np.float64)
+    return mesh, points, uv * [2 * fh.STUBBLE_SPAN_U, fh.STUBBLE_V[1] - fh.STUBBLE_V[0]]
+
+
+def test_stubble_is_not_stretched_under_the_chin(frame):
+    """Down the skin under the chin (faces looking down) the atlas runs at most of a metre
+    per metre, as on the face: v was the height, which barely changes where the skin runs
+    back level, so the stubs were drawn as streaks (a fifth of the rate in places)."""
+    body, (centre, mouth, eye_z, chin_z) = frame
+    _, points, uv = _stubble_uv_metres(body)
+    e1, e2 = points[:, 1] - points[:, 0], points[:, 3] - points[:, 0]
+    normal = np.cross(e1, e2)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    a = e1 / np.linalg.norm(e1, axis=1, keepdims=True)
+    b = np.cross(normal, a)
+    local = np.stack([np.stack([e @ a_, e @ b_]) for e, a_, b_ in zip(
+        np.concatenate([e1, e2]), np.concatenate([a, a]), np.concatenate([b, b]),
+        strict=True)]).reshape(2, -1, 2).transpose(1, 0, 2)  # fmt: skip
+    d_uv = np.stack([uv[:, 1] - uv[:, 0], uv[:, 3] - uv[:, 0]], 1)
+    jacobian = np.linalg.solve(local, d_uv)  # (F, 2, 2): surface metres -> atlas metres
+    grad_v = np.linalg.norm(jacobian[:, :, 1], axis=1)
+    c = points.mean(axis=1)
+    normal *= np.sign(np.einsum("fd,fd->", normal, c - centre))  # outward
+    under = normal[:, 2] < -0.6
+    face_ = (c[:, 2] > mouth[2]) & (c[:, 2] < eye_z)
+    assert under.sum() > 100
+    assert 0.7 < np.median(grad_v[under]) < 1.3 and np.percentile(grad_v[under], 10) > 0.35
+    assert 0.8 < np.median(grad_v[face_]) < 1.2
+
+
+def test_stubble_thins_out_to_the_lips(frame):
+    """The stubble's edge round the lips falls on (nearly) no density, not a hard line,
+    and a centimetre above the lip it is full again."""
+    from avatar.geometry.shell import boundary_edges
+    from avatar.looks import facial_hair as fh
+
+    body, (_, mouth, *_) = frame
+    mesh = face.stubble(body).mesh
+    rim = np.unique(boundary_edges(mesh.faces)[0])
+    rim = rim[np.linalg.norm(mesh.vertices[rim] - mouth, axis=1) < 0.045]  # the lips' rim
+    uv = np.zeros((len(mesh.vertices), 2), np.float32)
+    uv[mesh.faces.ravel()] = mesh.uvs[mesh.face_uvs.ravel()]
+    shape = (760, 920)
+    density = fh.stubble_density(shape)
+    rows = np.clip(((1 - uv[rim, 1]) * shape[0]).astype(int), 0, shape[0] - 1)
+    cols = np.clip((uv[rim, 0] * shape[1]).astype(int), 0, shape[1] - 1)
+    assert len(rim) > 30 and np.median(density[rows, cols]) < 0.1
+    above = (0.012 - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])  # 12 mm up
+    assert density[int((1 - above) * shape[0]), shape[1] // 2] > 0.9

@@ -14,7 +14,7 @@ from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, sin
 from avatar.clothes.hair import around, cards_on, head_frame, per_corner
 from avatar.geometry.shell import boundary_edges
 from avatar.looks.facial_hair import CHEEK_DEG, CHEEK_M, EDGE_M, WOBBLE_M  # noqa: F401
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, vertex_normals
 
 
 def eyebrows(body: AuthoringBody, inner=0.019, outer=0.03, low=0.006, height=0.022) -> Piece:
@@ -350,23 +350,62 @@ STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble's stubs covers
 
 def stubble(body: AuthoringBody) -> Piece:
     """Stubble: the beard's skin lifted half a millimetre, with UVs over the stubble atlas
-    (``looks.facial_hair.stubble_material``): u the arc round the face, v the height from
-    the mouth, in metres over ``facial_hair.STUBBLE_SPAN_U`` / ``STUBBLE_V``, so the atlas's
-    density fades out at the beard's cheek line and sideburns; below the mouth v is scaled
-    so the throat's edge (2 cm under the chin) lands on ``STUBBLE_THROAT_M``."""
+    (``looks.facial_hair.stubble_material``) in metres along the skin, so the stubs keep
+    their size everywhere: u the distance round the face from its midline (signed, over
+    ``facial_hair.STUBBLE_SPAN_U``), v the height above the mouth on the face and, below
+    the chin's tip, the distance down the skin from there (``STUBBLE_V``). Heights and
+    angles alone squeezed the stubs into streaks under the chin, where the skin runs back
+    level and close to the head's axis. v below the mouth is scaled so the throat's edge
+    (2 cm under the chin) lands on ``STUBBLE_THROAT_M``; the atlas's density fades out at
+    the beard's cheek line, sideburns, throat and lips."""
     from avatar.looks import facial_hair as fh
 
     faces = body.skin_faces
     mesh = cut(body, faces, facial_hair_mask(body, "beard"), 0.0005, relax=4)
     centre, mouth, _, chin_z = mouth_frame(body)
-    p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, 4, 3)
-    rel = p - (centre - [0.0, fh.STUBBLE_BACK_M, 0.0])  # the beard's back cut: 90 degrees
-    angle = np.arctan2(rel[..., 0], -rel[..., 1])  # round the head
-    arc = angle * fh.ARC_RADIUS_M
-    rel_z = p[..., 2] - mouth[2]
-    throat = (chin_z - 0.02) - mouth[2]  # < 0
-    rel_z = np.where(rel_z < 0, rel_z * (fh.STUBBLE_THROAT_M / throat), rel_z)
-    u = (arc / fh.STUBBLE_SPAN_U + 1) / 2
-    v = (rel_z - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])
-    return bound(body, per_corner(mesh, np.stack([u, v], -1).reshape(-1, 2).astype(np.float32)),
-                 faces)  # fmt: skip
+    p = mesh.vertices.astype(np.float64)
+    rel_z = p[:, 2] - mouth[2]
+    normal = vertex_normals(mesh.vertices, mesh.faces)
+    normal *= np.sign(np.einsum("vd,vd->", normal, p - centre))  # outward, whatever the winding
+    # u: the arc round the face at ARC_RADIUS_M (the atlas's cheek line is drawn in
+    # angles); nearer the head's axis (under the chin, the throat), where that arc would
+    # squeeze the stubs, the distance from the midline over the skin.
+    axis = centre - [0.0, fh.STUBBLE_BACK_M, 0.0]
+    angle = np.arctan2(p[:, 0], -(p[:, 1] - axis[1]))
+    midline = np.flatnonzero(np.abs(p[:, 0]) < 0.004)
+    across = np.sign(p[:, 0]) * _over_the_skin(mesh, midline, np.abs(p[midline, 0]))
+    near = np.clip((fh.ARC_RADIUS_M - np.hypot(p[:, 0], p[:, 1] - axis[1])) / 0.02, 0, 1)
+    near *= np.clip((np.radians(60) - np.abs(angle)) / np.radians(20), 0, 1)  # not the sides
+    u_m = (1 - near) * angle * fh.ARC_RADIUS_M + near * across
+    # v: the face's own height down to the chin's tip, then over the skin.
+    upright = np.flatnonzero((rel_z >= chin_z - mouth[2]) & (normal[:, 2] > -0.4))
+    down = -_over_the_skin(mesh, upright, np.maximum(-rel_z[upright], 0.0))
+    v_m = np.where(rel_z >= 0, rel_z, down)
+    edge = np.median(v_m[np.abs(p[:, 2] - (chin_z - 0.02)) < 0.004])  # the throat's edge
+    v_m = np.where(v_m < 0, v_m * (fh.STUBBLE_THROAT_M / min(edge, -0.01)), v_m)
+    u = (u_m / fh.STUBBLE_SPAN_U + 1) / 2
+    v = (v_m - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])
+    uv = np.stack([u, v], -1)[mesh.faces].reshape(-1, 2)
+    return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
+
+
+def _over_the_skin(mesh: Mesh, seeds: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """(V,) metres over the mesh's edges from the nearest of the ``seeds`` (vertex
+    indices), each already ``start`` (len(seeds),) m from the origin of the measure
+    (a shortest-path search from a virtual source joined to each seed by its start)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    n = len(mesh.vertices)
+    a = mesh.faces.reshape(-1)
+    b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
+    # Each edge once (a sparse matrix sums repeated entries: shared edges came doubled).
+    edges = np.unique(np.sort(np.stack([a, b], 1)[a != b], axis=1), axis=0)
+    a, b = edges.T
+    length = np.linalg.norm(mesh.vertices[a] - mesh.vertices[b], axis=1).astype(np.float64)
+    rows = np.concatenate([a, b, np.full(len(seeds), n)])
+    cols = np.concatenate([b, a, seeds])
+    weights = np.concatenate([length, length, np.asarray(start, np.float64) + 1e-9])
+    graph = coo_matrix((weights, (rows, cols)), shape=(n + 1, n + 1)).tocsr()
+    distance = dijkstra(graph, indices=n)[:n]
+    return np.where(np.isfinite(distance), distance, 0.0)

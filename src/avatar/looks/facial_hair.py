@@ -36,6 +36,8 @@ STUBBLE_V = (-0.11, 0.08)
 STUBBLE_THROAT_M = -0.074  # the beard's lower edge (2 cm under the chin), default adult
 STUBBLE_TILE_M = 0.03
 STUBBLE_INSET_M = 0.005  # stubble fades out this far inside the beard's cheek line
+# The lips' hole in the atlas: half width, half height and middle (v, m from the mouth).
+STUBBLE_LIPS_M = (0.028, 0.0165, -0.0155)
 STUBBLE_BACK_M = 0.01  # u's angle is measured about the skull centre moved this far forward
 
 # Greying (MakeHuman age: 0.5 = 25 years, 1 = 90): grey strands appear from GREY_FROM and
@@ -118,8 +120,8 @@ def stubble_density(shape: tuple[int, int]) -> np.ndarray:
     """(H, W) float32 density of stubble over the atlas (row 0 the top, v = 1): 1 inside
     the beard area, 0 outside, falling off over ``EDGE_M`` just inside the beard's cheek
     line (``STUBBLE_INSET_M`` below it), in front of the ears (u's angle measured about
-    the point where ``clothes.face`` cuts the beard off at the back: 0 at 90 degrees) and
-    under the chin (``STUBBLE_THROAT_M``)."""
+    the point where ``clothes.face`` cuts the beard off at the back: 0 at 90 degrees),
+    under the chin (``STUBBLE_THROAT_M``) and round the lips (``STUBBLE_LIPS_M``)."""
     h, w = shape
     u = (np.arange(w) + 0.5) / w
     v = 1 - (np.arange(h) + 0.5) / h
@@ -131,10 +133,15 @@ def stubble_density(shape: tuple[int, int]) -> np.ndarray:
     wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
     top = np.interp(t, CHEEK_DEG, CHEEK_M) + wobble - STUBBLE_INSET_M
     back = np.radians(90 - t) * ARC_RADIUS_M  # m of arc in front of the cut
+    # Round the lips (the stubble piece's hole): thinning to nothing at the lips' edge,
+    # full within a few millimetres, as fine hair does at the vermilion border.
+    half_u, half_v, middle_v = STUBBLE_LIPS_M
+    lips = np.hypot(np.meshgrid(arc, rel_z)[0] / half_u, (z - middle_v) / half_v)
     d = (
         _soft((top - z) / EDGE_M)
         * _soft((back - 0.5 * EDGE_M) / EDGE_M)
         * _soft((z - STUBBLE_THROAT_M) / EDGE_M)
+        * _soft((lips - 1.22) / 0.45)
     )
     return d.astype(np.float32)
 
