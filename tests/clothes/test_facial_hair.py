@@ -239,3 +239,15 @@ def test_stubble_thins_out_to_the_lips(frame):
     assert len(rim) > 30 and np.median(density[rows, cols]) < 0.1
     above = (0.012 - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])  # 12 mm up
     assert density[int((1 - above) * shape[0]), shape[1] // 2] > 0.9
+
+
+def test_moustache_thins_out_under_the_nose(frame):
+    """The moustache's top under the nose is not a line: in its middle, the top 2 mm of
+    roots are far sparser than the full hair below (they were as dense: a felt block)."""
+    body, (_, mouth, *_) = frame
+    roots, _ = _roots(face.moustache(body))
+    middle = np.abs(roots[:, 0]) < 0.4 * face.MOUSTACHE_HALF_M
+    depth = np.percentile(roots[middle, 2], 98) - roots[middle, 2]
+    top = ((depth >= 0) & (depth < 0.002)).sum()
+    full = ((depth >= 0.004) & (depth < 0.008)).sum() / 2
+    assert top < 0.6 * full

@@ -229,11 +229,12 @@ def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> n
     if part == "moustache":
         # Across the lip (0 middle, 1 corner of the mouth): the upper edge falls from
         # under the nose towards the corners, the lower one follows the lip line down.
+        # Its top thins out over 6 mm under the nose (a 3 mm edge drew a hard top line).
         across = np.abs(points[:, 0]) / MOUSTACHE_HALF_M
-        top = 0.017 - 0.03 * across**1.4
+        top = 0.018 - 0.03 * across**1.4
         bottom = -0.004 - 0.008 * across**2
         return (
-            _soft((top - rel_z) / 0.003)
+            _soft((top - rel_z) / 0.006)
             * _soft((rel_z - bottom) / 0.002)
             * _soft((1 - across) / 0.12)
         )
@@ -331,8 +332,9 @@ def beard(body: AuthoringBody, count: int = 3600, length=(0.007, 0.013)) -> Piec
     ])  # fmt: skip
 
 
-def moustache(body: AuthoringBody, count: int = 480) -> Piece:
-    """A moustache: narrow strand cards over the upper lip, combed down and out over it,
+def moustache(body: AuthoringBody, count: int = 600) -> Piece:
+    """A moustache: narrow strand cards (2.4 mm, a dozen hairs) over the upper lip, of
+    uneven length (a ragged lower edge), combed down and fanning out over it,
     full under the nose and tapering to points at the corners of the mouth
     (``facial_hair_density(body, "moustache", ...)``)."""
     centre, *_ = mouth_frame(body)
@@ -341,8 +343,22 @@ def moustache(body: AuthoringBody, count: int = 480) -> Piece:
     def density(points: np.ndarray) -> np.ndarray:
         return facial_hair_density(body, "moustache", points)
 
-    return cards_on(body, keep, _beard_flow(centre), count, (0.008, 0.013), 0.0032,
+    return cards_on(body, keep, _moustache_flow(), count, (0.007, 0.015), 0.0024,
                     (0.001, 0.0025), seed=1, density=density)  # fmt: skip
+
+
+def _moustache_flow():
+    """Moustache hair grows down from the middle of the lip and fans out towards the
+    corners of the mouth (a comb's chevron, not every card straight down: parallel cards
+    read as a felt block)."""
+
+    def flow(points: np.ndarray) -> np.ndarray:
+        d = np.zeros_like(points)
+        d[:, 2] = -1.0
+        d[:, 0] = 0.15 * np.sign(points[:, 0]) + 0.7 * points[:, 0] / MOUSTACHE_HALF_M
+        return d
+
+    return flow
 
 
 STUBBLE_TILE = 0.03  # m of skin one repeat of the stubble's stubs covers

@@ -141,7 +141,7 @@ def stubble_density(shape: tuple[int, int]) -> np.ndarray:
         _soft((top - z) / EDGE_M)
         * _soft((back - 0.5 * EDGE_M) / EDGE_M)
         * _soft((z - STUBBLE_THROAT_M) / EDGE_M)
-        * _soft((lips - 1.22) / 0.45)
+        * _soft((lips - 1.1) / 0.25)
     )
     return d.astype(np.float32)
 
