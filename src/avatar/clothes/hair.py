@@ -361,20 +361,23 @@ def long_cards(
 
 
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
-                surface: np.ndarray | None = None) -> Piece:  # fmt: skip
+                surface: np.ndarray | None = None, taper: float = 0.7,
+                tip_v: float = 0.0) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
-    (or to ``surface``, (S, 4) base-mesh faces of it)."""
+    (or to ``surface``, (S, 4) base-mesh faces of it), narrowing to ``taper`` of their
+    width at the tips, their texture running from the roots (v = 0.5) to ``tip_v`` (0:
+    the texture's thinned-out strand tips; more: cut ends, as a blunt haircut has)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
     half = (width / 2) * rng.uniform(0.7, 1.2, count)[:, None, None]
-    half = half * np.linspace(1, 0.7, k)[None, :, None]
+    half = half * np.linspace(1, taper, k)[None, :, None]
     verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2K, 3)
     j = np.arange(k - 1)
     quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
     faces = (quad[None] + (2 * k * np.arange(count))[:, None, None]).reshape(-1, 4)
     u0 = rng.uniform(0, 1, count)[:, None]
-    v = 0.5 * (1 - np.linspace(0, 1, k))[None, :]
+    v = 0.5 - (0.5 - tip_v) * np.linspace(0, 1, k)[None, :]
     left = np.stack(np.broadcast_arrays(u0, v), -1)
     uv = np.concatenate([left, left + [0.12, 0.0]], 1).reshape(-1, 2).astype(np.float32)
     mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
@@ -382,9 +385,15 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     return bound(body, mesh, body.skin_faces if surface is None else surface)
 
 
-def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 60, seed: int = 2) -> Piece:
+def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 150, seed: int = 2) -> Piece:
     """A tied-back tail: strand cards around a spine hanging from the back of the head,
-    gathered tight at the tie, fuller below it and tapering to the tips."""
+    gathered tight at the tie, fuller below it and tapering to the tips.
+
+    A bundle, not a ribbon: many narrow cards (1.3 cm) fill the tail's whole section
+    (each at its own depth, from the core to the surface) and each is turned by its own
+    angle about the spine, so from any side some are seen face on and some edge on; their
+    paths wander and their tips splay apart. (60 cards 2 cm wide on the tail's surface,
+    all facing out, read as one flat ribbon with strands painted on.)"""
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
     back = body.vertices[:BODY_VERTICES][body.part[:BODY_VERTICES] == "head"][:, 1].max()
@@ -395,11 +404,19 @@ def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 60, seed: in
     spine = root + np.stack([0 * t, 0.05 * np.sin(t * np.pi / 2) + 0.03 * t, -length * t], 1)
     radius = 0.008 + 0.022 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.5 * t)
     angle = rng.uniform(0, 2 * np.pi, count)[:, None] + rng.normal(0, 0.3, count)[:, None] * t
-    reach = rng.uniform(0.8, 1.05, count)[:, None]
+    reach = np.sqrt(rng.uniform(0.1, 1.0, count))[:, None] * 1.05  # filled, not a shell
+    splay = 1 + 0.35 * t[None, :] ** 3 * rng.uniform(0, 1, count)[:, None]  # tips part
     radial = np.stack([np.cos(angle), np.sin(angle) * 0.7, np.zeros_like(angle)], -1)
-    path = spine[None] * np.array([1, 1, 0]) + radial * (radius * reach)[..., None]
-    path[..., 2] = root[2] - length * t[None, :] * reach
-    return _card_piece(body, path, radial, 0.02, rng)
+    path = spine[None] * np.array([1, 1, 0]) + radial * (radius * reach * splay)[..., None]
+    wander = rng.normal(0, 0.004, (count, 1, 3)) * np.sin(np.pi * t)[None, :, None]
+    path = path + wander * np.array([1, 1, 0])
+    path[..., 2] = root[2] - length * t[None, :] * rng.uniform(0.8, 1.05, count)[:, None]
+    # Each card turned about the spine by its own angle (the cards' faces point along
+    # ``radial`` turned towards the tangent round the tail).
+    turn = rng.uniform(-1.0, 1.0, count)[:, None, None]
+    around = np.stack([-radial[..., 1], radial[..., 0], np.zeros_like(angle)], -1)
+    facing = np.cos(turn) * radial + np.sin(turn) * around
+    return _card_piece(body, path, facing, 0.013, rng)
 
 
 def brim(body: AuthoringBody, cap: Piece, reach: float = 0.07) -> Piece:
@@ -449,7 +466,7 @@ def hang_cards(
     body: AuthoringBody,
     flow,
     count: int = 520,
-    end: tuple[float, float] = (-0.09, -0.075),
+    end: tuple[float, float] = (-0.088, -0.08),
     fringe: float | None = 0.035,
     width: float = 0.022,
     lift=(0.004, 0.02),
@@ -459,7 +476,8 @@ def hang_cards(
     """Hair that falls: cards rooted inside the hairline, combed along ``flow`` over the
     scalp, then bending down under their weight, never nearer the skin than their lift, cut
     level at ``end`` (low, high) m relative to eye height (a bob's blunt line; each card
-    ends at a random height in that range). Roots facing the face (within 50 degrees of the
+    ends at a random height in that range, and its texture is cut there, not thinned
+    out). Roots facing the face (within 50 degrees of the
     front) make a ``fringe`` ending that far above the eyes (None: parted off the face).
     """
     rng = np.random.default_rng([seed, count])
@@ -486,7 +504,9 @@ def hang_cards(
     path = np.stack(rows, 1)  # (N, K+1, 3)
     path = _cut_at(path, stop)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
-    return _card_piece(body, path, normal, width, rng)
+    # A blunt cut: full-width cards to the end, their strands cut there rather than
+    # thinning out (tapered, thinned tips a centimetre apart read as frayed ends).
+    return _card_piece(body, path, normal, width, rng, taper=0.95, tip_v=0.25)
 
 
 def _off_skin(body: AuthoringBody, points: np.ndarray, gap) -> np.ndarray:
