@@ -159,3 +159,74 @@ def test_cap_brim_is_a_visor_in_front_not_a_bucket():
         # A flat-ish pre-curved plate: its edge drops at most 2.5 cm from middle to sides.
         edge = v[v[:, 1] < v[:, 1].min() + 0.01]
         assert np.ptp(v[:, 2]) < 0.045 and np.ptp(edge[:, 2]) < 0.025
+
+
+# ---------------------------------------------------------------------------- swimsuit
+
+
+@pytest.mark.parametrize("name", ["swimsuit", "leggings"])
+def test_stretch_garments_hug_the_seat(name):
+    """Lycra lies on the skin: over the seat a swimsuit or leggings stood 6.6 mm off it
+    all round (the tights shell's own distance), baggy. Signed distances to the skin
+    surface on a teen and a heavy woman, at rest; nothing inside."""
+    from avatar.clothes.authoring import AuthoringBody
+    from avatar.geometry import collision
+
+    for params in ({"gender": 0.0, "age": 0.3, "weight": 0.35},
+                   {"gender": 0.0, "age": 0.6, "weight": 1.0}):  # fmt: skip
+        human = Human(params).dressed(name)
+        fitted = human.outfit.garments[0]
+        v = fitted.mesh.vertices[: len(fitted.garment.mesh.vertices)].astype(np.float64)
+        marks = AuthoringBody(human.body).marks
+        base = human.model.base
+        surface = collision.skin_surface(base.faces[base.face_groups["body"]])
+        off = collision.query(human.vertices[:13380], surface, v, k=4).distance
+        hip_z = marks.hip[0, 2]
+        seat = (v[:, 1] > marks.hip[0, 1]) & (v[:, 2] > hip_z - 0.1) & (v[:, 2] < hip_z + 0.05)
+        assert seat.sum() > 10
+        assert np.median(off[seat]) < 0.004, (params, np.median(off[seat]))
+        assert off.min() > -0.001
+
+
+# ---------------------------------------------------------------------------- knit
+
+
+def _v_gradients(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(face centres (F, 3), unit 3D directions in which the texture's v grows (F, 3),
+    usable (F,) bool: faces with real area in space and in UV, not a band's lip)."""
+    v = mesh.vertices[mesh.faces].astype(np.float64)
+    uv = mesh.uvs[mesh.face_uvs].astype(np.float64)
+    e1, e2 = v[:, 1] - v[:, 0], v[:, -1] - v[:, 0]
+    n = np.cross(e1, e2)
+    system = np.stack([e1, e2, n], 1)
+    usable = (np.linalg.norm(n, axis=1) > 2e-5) & (np.abs(np.cross(uv[:, 1] - uv[:, 0],
+                                                                   uv[:, -1] - uv[:, 0])) > 1e-4)
+    rhs = np.stack([uv[:, 1, 1] - uv[:, 0, 1], uv[:, -1, 1] - uv[:, 0, 1], np.zeros(len(v))], 1)
+    g = np.zeros_like(n)
+    g[usable] = np.linalg.solve(system[usable], rhs[usable][..., None])[..., 0]
+    g /= np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-12)
+    return v.mean(axis=1), g, usable
+
+
+@pytest.mark.parametrize("name", ["cardigan", "longsleeve", "tshirt"])
+def test_knit_rows_turn_over_only_at_the_shoulder_ridge(name):
+    """A knit's V-loops follow the texture's v: up the front and up the back, meeting
+    head to head along the shoulders' ridge as at a shoulder seam. The faces on top of
+    the shoulders took v = y, so the loops turned over at the back of the shoulders
+    instead (a chevron across the upper back)."""
+    from avatar.clothes import builtin, library
+
+    body = library.authoring_body()
+    m = body.marks
+    mesh = builtin.BY_NAME[name].make(body).mesh
+    centre, g, usable = _v_gradients(mesh)
+    ridge = float(m.shoulder[:, 1].mean())
+    shoulders = (usable & (centre[:, 2] > m.shoulder[0, 2] - 0.04)
+                 & (np.abs(centre[:, 0]) < abs(m.shoulder[0, 0]))
+                 & (np.abs(centre[:, 1] - ridge) > 0.025))  # fmt: skip
+    assert shoulders.sum() > 20
+    towards_ridge = np.zeros((shoulders.sum(), 3))
+    towards_ridge[:, 1] = np.sign(ridge - centre[shoulders, 1])
+    towards_ridge[:, 2] = 1.0
+    rising = np.einsum("nd,nd->n", g[shoulders], towards_ridge) > 0
+    assert rising.mean() > 0.97, centre[shoulders][~rising].round(3)

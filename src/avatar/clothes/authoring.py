@@ -101,7 +101,8 @@ def cut(
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
     points = points + np.asarray(ease)[..., None] * normals
-    mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local))
+    ridge = float(body.marks.shoulder[:, 1].mean())
+    mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local), ridge_y=ridge)
     return with_limb_uvs(mesh, body.part[used], body.marks)
 
 
@@ -171,17 +172,22 @@ def orient_outward(body: AuthoringBody, points: np.ndarray, faces: np.ndarray) -
     return Mesh(vertices=points, faces=faces)
 
 
-def with_box_uvs(mesh: Mesh, tile: float = TILE_METRES) -> Mesh:
+def with_box_uvs(mesh: Mesh, tile: float = TILE_METRES, ridge_y: float | None = None) -> Mesh:
     """Per-corner UVs by projecting each face on the plane its normal faces most (in tiles).
 
-    Vertical faces keep z as v, so the fabric's warp runs down the body.
+    Vertical faces keep z as v, so the fabric's warp runs down the body. ``ridge_y``: the
+    y of the shoulders' ridge: faces facing up or down take v = z - |y - ridge_y|, rising
+    towards the ridge from the front and from the back as the faces below them do, so a
+    directional weave (a knit's V-loops) turns over only along the ridge, as at a
+    shoulder seam (with v = y it turned over at the back of the shoulders, a chevron).
     """
     f = mesh.faces
     v = mesh.vertices[f].astype(np.float64)  # (F, C, 3)
     n = np.abs(np.cross(v[:, 2] - v[:, 0], v[:, -1] - v[:, 1]))
     axis = np.argmax(n, axis=1)[:, None]
     u = np.where(axis == 0, v[..., 1], v[..., 0])
-    w = np.where(axis == 2, v[..., 1], v[..., 2])
+    flat = v[..., 1] if ridge_y is None else v[..., 2] - np.abs(v[..., 1] - ridge_y)
+    w = np.where(axis == 2, flat, v[..., 2])
     uvs = np.stack([u, w], -1).reshape(-1, 2) / tile
     face_uvs = np.arange(f.size, dtype=np.int32).reshape(f.shape)
     return Mesh(mesh.vertices, f, uvs.astype(np.float32), face_uvs)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, join
 from avatar.clothes.regions import Landmarks
 from avatar.geometry.shell import boundary_edges
@@ -422,6 +423,22 @@ def skin_offset(body: AuthoringBody, points: np.ndarray, k: int = 6,
     return np.einsum("nk,nk->n", w, above), normal
 
 
+def hug_skin(body: AuthoringBody, points: np.ndarray, gap: float,
+             deepest: float = 0.004) -> np.ndarray:  # fmt: skip
+    """(N, 3) points laid ``gap`` m off the skin: a stretch garment (a swimsuit, leggings)
+    cut from ``helper-tights`` otherwise keeps that shell's own 5-6 mm off the skin and
+    reads as loose cloth, baggy over the seat. Each point moves in along the normal at its
+    closest skin point (the exact surface: the tangent planes of nearby vertices read
+    2.5 mm where the skin of a buttock was 5 mm away), by at most ``deepest`` m, so cloth
+    bridging a cleft dips into it a little instead of lining it."""
+    from avatar.geometry import collision
+
+    surface = collision.skin_surface(body.skin_faces)
+    q = collision.query(body.vertices[:BODY_VERTICES], surface, points, k=6)
+    move = np.clip(q.distance.astype(np.float64) - gap, 0, deepest)
+    return points - move[:, None] * q.normal.astype(np.float64)
+
+
 def sit_on_hips(body: AuthoringBody, points: np.ndarray, ease: float, hip_z: float,
                 fall: float = 0.12, under: np.ndarray | None = None,
                 gap: float = 0.004, edge_gap: float = 0.0025,
@@ -535,6 +552,7 @@ __all__ = [
     "belt_loops",
     "body_axis",
     "heights",
+    "hug_skin",
     "jeans_marks",
     "layout",
     "leg_axis",
