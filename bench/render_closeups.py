@@ -68,7 +68,7 @@ FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM)}
 # and the views (name -> direction from subject to camera).
 VIEWS = {
     "front": (0.0, -1.0, 0.05), "side": (0.9, -1.0, 0.1), "back": (0.0, 1.0, 0.1),
-    "low": (0.7, -1.0, 0.35), "top": (0.3, 1.0, 1.0),
+    "low": (0.7, -1.0, 0.35), "top": (0.0, 0.75, 1.0),
 }  # fmt: skip
 
 
