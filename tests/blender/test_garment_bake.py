@@ -73,7 +73,7 @@ def test_correction_keys_are_driven_by_the_key_action(empty_scene, dressed, tmp_
     import bpy
 
     import avatar
-    from avatar.clothes.bake import MAX_BASIS
+    from avatar.clothes.correction_basis import MAX_BASIS
 
     human, walk = dressed
     avatar.save(human, tmp_path / "walk.usdc", walk)

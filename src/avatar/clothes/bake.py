@@ -35,7 +35,7 @@ is only one way out of it. So the bake plays every frame back as a viewer will
 out (``MARGIN`` beyond it). The first ``REFITS`` checks solve the frame's weights again with
 them weighted ``HEAVY`` and refit the shapes to the mended frames (low-rank by
 construction); the later ones give the frames they mend a few sparse shapes of their own
-that play the push-outs (``_grow``, at most ``GROW`` a check), which converges: only those
+that play the push-outs (``grow``, at most ``GROW`` a check), which converges: only those
 frames change, so only those are checked again. A check measures only vertices that can be
 that deep: the distance to the skin changes at most as much as the point moves, so a
 played-back vertex closer to its exact position than that position's clearance (+ bound) is
@@ -49,13 +49,23 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
 
 from avatar.body.model import BODY_VERTICES
 from avatar.body.shaped import Body
+from avatar.clothes.correction_basis import (
+    ERROR_BOUND,
+    Basis,
+    Corrections,
+    fit,
+    grow,
+    refit,
+    segment_targets,
+    solve_weights,
+)
 from avatar.clothes.outfit import Outfit
 from avatar.errors import AvatarError
 from avatar.geometry import collision
@@ -68,17 +78,12 @@ log = logging.getLogger(__name__)
 
 TOLERANCE = 5e-5  # m; smaller corrections are left out (the targets stay sparse)
 SINGULAR = 1e-6  # |det A| below which a vertex's blended matrix is inverted by pseudo-inverse
-ERROR_BOUND = 5e-4  # m: worst distance of a played-back garment vertex from its exact frame
-MAX_BASIS = 16  # correction shapes a garment segment gets (fewer when they meet ERROR_BOUND)
 SEGMENT = 300  # most frames one basis holds: longer clips are cut into equal windows
 GROW = 8  # most shapes a late check adds to a segment's basis for the frames it mended
-GROW_BOUND = 1e-4  # m: how closely those shapes play the mended frames' push-outs
-LIMIT = 64  # most shapes a garment gets when ERROR_BOUND needs more than MAX_BASIS
 BASIS_PREFIX = "correction_"
 REFINE_PASSES = 12  # play-back checks; each pushes out what went inside (stops when none did)
 REFITS = 6  # the first checks that also refit the shapes to the mended frames
 MARGIN = 1.5e-3  # m: how far outside the skin a check puts a vertex it pushes out
-HEAVY = 100.0  # weight of pushed-out vertices in a frame's least-squares weights
 SLACK = 2e-4  # m: checks measure vertices this near their bound (the skin query is approximate)
 
 
@@ -142,50 +147,6 @@ def segments(frames: int, length: int = SEGMENT) -> list[range]:
 
 
 @dataclass
-class Corrections:
-    """One garment's per-frame bind-space deltas, stored sparsely as they are computed."""
-
-    vertices: int
-    frames: int
-    rows: dict[int, np.ndarray] = field(default_factory=dict)  # t -> (n,) moved vertices
-    deltas: dict[int, np.ndarray] = field(default_factory=dict)  # t -> (n, 3) float32
-
-    def add(self, t: int, delta: np.ndarray) -> None:
-        rows = np.flatnonzero(np.any(delta != 0, axis=1))
-        self.rows[t], self.deltas[t] = rows, np.asarray(delta[rows], dtype=np.float32)
-
-    def matrix(self) -> tuple[np.ndarray, np.ndarray]:
-        """(moved (U,) vertex indices, X (T, U, 3) float32 deltas of those vertices)."""
-        moved = np.unique(np.concatenate([np.zeros(0, np.int64), *self.rows.values()]))
-        x = np.zeros((self.frames, len(moved), 3), dtype=np.float32)
-        for t, rows in self.rows.items():
-            x[t, np.searchsorted(moved, rows)] = self.deltas[t]
-        return moved, x
-
-
-@dataclass(frozen=True)
-class Basis:
-    """A garment's compact correction over one segment: shapes (k, U, 3) over vertices
-    ``moved`` (U,), weights (n, k) for the segment's n frames, and the worst per-vertex
-    reconstruction error (m)."""
-
-    moved: np.ndarray
-    shapes: np.ndarray
-    weights: np.ndarray
-    error: float
-
-    def moved_delta(self, t: int) -> np.ndarray:
-        """(U, 3) float64 bind-space correction of the moved vertices at segment frame t."""
-        return np.einsum("k,kvc->vc", self.weights[t].astype(np.float64), self.shapes)
-
-    def delta(self, t: int, vertices: int) -> np.ndarray:
-        """(vertices, 3) float64 bind-space correction this basis plays at segment frame t."""
-        out = np.zeros((vertices, 3))
-        out[self.moved] = self.moved_delta(t)
-        return out
-
-
-@dataclass
 class _Window:
     """One segment's frames as the bake needs them again after resolving them: skinned body
     (n, BODY_VERTICES, 3) float32, skinning matrices (n, J, 4, 4), per garment its exact
@@ -245,24 +206,29 @@ class _Job:
 
         The first ``REFITS`` checks re-solve the weights of the frames they mend and refit
         the shapes to the mended frames (every frame is then checked again); the later ones
-        add the mended frames' push-outs as a few sparse shapes of their own (``_grow``),
-        which only those frames play, so only those are checked again.
+        add the mended frames' push-outs as a few sparse shapes of their own (``grow``, at
+        most ``GROW``; the last one as many as it takes to play them exactly), which only
+        those frames play, so only those are checked again.
         """
         bases = [fit(c, self.bound) for c in window.corrections]
         heavy: list[dict[int, np.ndarray]] = [{} for _ in self.garments]  # t -> pushed vertices
         frames: Iterable[int] = range(len(window.bodies))
-        for step in range(REFINE_PASSES):
-            refit = step < REFITS
-            mended = self.check(window, bases, heavy, frames, solve=refit)
+        for step in range(REFINE_PASSES + 1):
+            refitting = step < REFITS
+            mended = self.check(window, bases, heavy, frames, solve=refitting)
             if not any(mended):
                 break
-            if refit:
+            if step == REFINE_PASSES:  # after the exact grow: only the skin query's slack
+                log.warning("%d frames keep a garment vertex over %.1f mm inside",
+                            len(set().union(*mended)), self.bound * 1e3)  # fmt: skip
+            elif refitting:
                 pairs = zip(window.corrections, heavy, strict=True)
-                bases = [_refit(c, self.bound, h) for c, h in pairs]
+                bases = [refit(c, self.bound, h) for c, h in pairs]
                 frames = range(len(window.bodies))
             else:
+                most = GROW if step < REFINE_PASSES - 1 else len(window.bodies)
                 bases = [
-                    b if b is None or not m else _grow(b, c, sorted(m))
+                    b if b is None or not m else grow(b, c, sorted(m), most)
                     for b, c, m in zip(bases, window.corrections, mended, strict=True)
                 ]
                 frames = sorted(set().union(*mended))
@@ -273,7 +239,7 @@ class _Job:
         """Play ``frames`` back as the file will (each basis, the player's skin); where a
         garment vertex lands more than ``bound`` inside the skin, make that frame's target
         the played frame with those vertices pushed out (MARGIN outside) and solve the
-        frame's weights again (``solve``) with them ``HEAVY`` (``_solve_weights``); a refit
+        frame's weights again (``solve``) with them ``HEAVY`` (``solve_weights``); a refit
         of the shapes carries them. Returns the frames it mended, per garment.
 
         The exact resolves are one way out of the body among many: the played-back frame, a
@@ -308,7 +274,7 @@ class _Job:
                 window.corrections[i].add(t, delta)
                 heavy[i][t] = np.union1d(heavy[i].get(t, np.zeros(0, np.int64)), basis.moved[deep])
                 if solve:
-                    _solve_weights(basis, window.corrections[i], t, heavy[i][t])
+                    solve_weights(basis, window.corrections[i], t, heavy[i][t])
                 mended[i].add(t)
                 pushed += len(deep)
         log.info("played-back check: %d garment vertex-frames pushed out", pushed)
@@ -353,106 +319,6 @@ class _Job:
         return suspect[deep], q.closest[deep] + MARGIN * q.normal[deep]
 
 
-def _solve_weights(basis: Basis, corrections: Corrections, t: int, pushed: np.ndarray) -> None:
-    """Frame t's weights (in place): least squares to its target, vertices ``pushed`` (garment
-    indices) weighted ``HEAVY``, so the frame keeps them out with the shapes it has."""
-    if not len(basis.shapes):
-        return
-    target = np.zeros((len(basis.moved), 3))
-    at = np.searchsorted(basis.moved, corrections.rows[t])
-    inside = at < len(basis.moved)
-    inside[inside] = basis.moved[at[inside]] == corrections.rows[t][inside]
-    target[at[inside]] = corrections.deltas[t][inside]
-    cost = np.ones(len(basis.moved))
-    rows = np.searchsorted(basis.moved, pushed)
-    found = rows < len(basis.moved)
-    found[found] = basis.moved[rows[found]] == pushed[found]
-    cost[rows[found]] = HEAVY
-    shapes = basis.shapes.reshape(len(basis.shapes), -1).astype(np.float64)
-    scaled = shapes * np.repeat(cost, 3)[None]
-    lhs, rhs = scaled @ shapes.T, scaled @ target.reshape(-1)
-    basis.weights[t] = np.linalg.lstsq(lhs, rhs, rcond=None)[0].astype(np.float32)
-
-
-def _refit(corrections: Corrections, bound: float, heavy: dict[int, np.ndarray]) -> Basis | None:
-    """``fit`` to the mended frames, then their weights solved with their pushed vertices
-    ``HEAVY``."""
-    basis = fit(corrections, bound)
-    for t, rows in heavy.items():
-        if basis is not None:
-            _solve_weights(basis, corrections, t, rows)
-    return basis
-
-
-def _grow(basis: Basis, corrections: Corrections, frames: list[int]) -> Basis:
-    """The basis with a few more shapes that play what ``frames`` miss of their targets
-    (the push-outs a check made: sparse, a few vertices each), weighted on those frames
-    only: the principal shapes of those residuals, at most ``GROW`` a call, within
-    ``GROW_BOUND``."""
-    residual = np.zeros((len(frames), len(basis.moved), 3), dtype=np.float32)
-    for r, t in enumerate(frames):
-        at = np.searchsorted(basis.moved, corrections.rows[t])
-        residual[r, at] = corrections.deltas[t]
-        residual[r] -= basis.moved_delta(t)
-    shapes, weights, _ = fit_basis(residual, GROW_BOUND, GROW)
-    out = np.zeros((len(basis.weights), len(basis.shapes) + len(shapes)), dtype=np.float32)
-    out[:, : len(basis.shapes)] = basis.weights
-    out[frames, len(basis.shapes) :] = weights
-    return Basis(basis.moved, np.concatenate([basis.shapes, shapes]), out, basis.error)
-
-
-def fit(corrections: Corrections, bound: float = ERROR_BOUND) -> Basis | None:
-    """The compact basis of one garment's corrections (``fit_basis``), None without any."""
-    if not corrections.rows:
-        return None
-    moved, x = corrections.matrix()
-    shapes, weights, error = fit_basis(x, bound, MAX_BASIS)
-    return Basis(moved, shapes, weights, error)
-
-
-def fit_basis(x: np.ndarray, bound: float = ERROR_BOUND, limit: int = LIMIT) -> tuple[
-    np.ndarray, np.ndarray, float
-]:  # fmt: skip
-    """The fewest principal shapes of per-frame deltas that reproduce every frame within
-    ``bound``: x (T, U, 3) -> shapes (k, U, 3) float32 orthonormal (flattened), weights
-    (T, k) float32 (projections, so frames without correction get 0), worst error (m).
-
-    k is the smallest count meeting ``bound``, at most ``limit`` (then the error says how
-    far off it is).
-    """
-    frames = len(x)
-    flat = x.reshape(frames, -1)
-    if not flat.size or not np.any(flat):
-        return np.zeros((0,) + x.shape[1:], np.float32), np.zeros((frames, 0), np.float32), 0.0
-    directions = _principal_directions(flat, limit)  # (L, N) float64 orthonormal rows
-    weights = flat.astype(np.float64) @ directions.T  # (T, L)
-    residual = flat.astype(np.float64)
-    for k in range(len(directions) + 1):
-        error = float(np.sqrt((residual.reshape(frames, -1, 3) ** 2).sum(axis=2).max()))
-        if error <= bound or k == len(directions):
-            break
-        residual -= np.outer(weights[:, k], directions[k])
-    shapes = directions[:k].reshape((k,) + x.shape[1:]).astype(np.float32)
-    return shapes, weights[:, :k].astype(np.float32), error
-
-
-def _principal_directions(flat: np.ndarray, limit: int) -> np.ndarray:
-    """The top ``limit`` right singular vectors (L, N) of flat (T, N), through the smaller
-    of the two Gram matrices (T x T or N x N), in float64."""
-    a = flat.astype(np.float64)
-    frames, size = a.shape
-    if frames <= size:
-        values, vectors = np.linalg.eigh(a @ a.T)
-        order = np.argsort(values)[::-1][:limit]
-        keep = order[values[order] > values[order[0]] * 1e-12]
-        out = vectors[:, keep].T @ a
-        return out / np.linalg.norm(out, axis=1, keepdims=True)
-    values, vectors = np.linalg.eigh(a.T @ a)
-    order = np.argsort(values)[::-1][:limit]
-    keep = order[values[order] > values[order[0]] * 1e-12]
-    return vectors[:, keep].T
-
-
 def _with_bases(part: MeshPart, windows: list[range], bases: list[Basis | None], bound: float,
                 frames: int) -> tuple[MeshPart, np.ndarray | None]:  # fmt: skip
     """The part with each segment's correction shapes as morphs, and its (T, targets) weights
@@ -462,7 +328,7 @@ def _with_bases(part: MeshPart, windows: list[range], bases: list[Basis | None],
     for s, (window, basis) in enumerate(zip(windows, bases, strict=True)):
         if basis is None or not len(basis.shapes):
             continue
-        targets, weights = _segment_targets(basis, len(part.mesh.vertices))
+        targets, weights = segment_targets(basis, len(part.mesh.vertices))
         keyed.append((window, len(morphs), weights))
         morphs |= {f"{BASIS_PREFIX}s{s:02d}_{name}": d for name, d in targets.items()}
     if not keyed:
@@ -472,28 +338,6 @@ def _with_bases(part: MeshPart, windows: list[range], bases: list[Basis | None],
     for window, column, weights in keyed:
         out[window.start : window.stop, column : column + weights.shape[1]] = weights
     return replace(part, morphs=morphs), out
-
-
-def _segment_targets(basis: Basis, vertices: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """One segment's morphs (name -> (vertices, 3) float32) and their (n, k + 1) weights.
-
-    Weights in [0, 1], which every player keeps (Blender's shape-key sliders and Unity clamp
-    to it): w = lo + (hi - lo) u, so x = sum lo_k s_k + sum u_k (hi_k - lo_k) s_k, the first
-    term an "offset" target held at 1 over the segment (the rest mesh is unchanged). A shape
-    whose weights reach further below 0 than above is flipped first, so that lo is small and
-    a shape played on a few frames only (``_grow``) stays at 0 on the others."""
-    flip = np.where(-basis.weights.min(axis=0) > basis.weights.max(axis=0), -1.0, 1.0)
-    moved, shapes, weights = basis.moved, basis.shapes * flip[:, None, None], basis.weights * flip
-    lo, hi = np.minimum(weights.min(axis=0), 0.0), np.maximum(weights.max(axis=0), 0.0)
-    span = np.where(hi - lo > 0, hi - lo, 1.0)
-    out = np.ones((len(weights), len(shapes) + 1), dtype=np.float32)
-    out[:, 1:] = np.clip((weights - lo) / span, 0.0, 1.0)
-    morphs = {"offset": np.zeros((vertices, 3), dtype=np.float32)}
-    morphs["offset"][moved] = np.einsum("k,kvc->vc", lo, shapes)
-    for k, shape in enumerate(shapes):
-        morphs[f"{k:02d}"] = np.zeros((vertices, 3), dtype=np.float32)
-        morphs[f"{k:02d}"][moved] = shape * span[k]
-    return morphs, out
 
 
 def _log_bases(name: str, bases: list[Basis], bound: float) -> None:
