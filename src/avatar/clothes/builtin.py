@@ -221,6 +221,10 @@ def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
 # It ends 3 cm under the skirt's top (helper-skirt reaches 13 cm above the hip joints): a
 # longer bodice showed through the skirt at the back as a stray panel.
 DRESS_HUG = 0.009  # m the dress's skirt keeps off the skin at the waist and hips
+# The skirt's faces span 3-4 cm: mid-stride the forward knee bulged between vertices kept
+# 5 mm clear and through both 1.5 mm layers (a speck of skin on the skirt). 6 mm clear and
+# 3 mm of cloth keep its outer surface outside the knee through the stride.
+DRESS_CLEARANCE, DRESS_THICKNESS = 0.006, 0.003
 dress_bodice = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
 
 
@@ -494,7 +498,7 @@ SPECS = [
     Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015, snug=SNUG), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
     Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",), clearance=0.006),  # noqa: E501
-    Spec("dress", "dresses", _dress, "cotton", "teal", 0.0015, 38, ("dress",), clearance=0.005),
+    Spec("dress", "dresses", _dress, "cotton", "teal", DRESS_THICKNESS, 38, ("dress",), clearance=DRESS_CLEARANCE),  # noqa: E501
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001, snug=SNUG), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "dark brown", "dark brown")),  # noqa: E501
