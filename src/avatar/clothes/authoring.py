@@ -340,3 +340,47 @@ def banded(mesh: Mesh, width=0.015, lift: float = 0.0015) -> Mesh:
     return Mesh(np.concatenate([v, lifted]).astype(np.float32),
                 np.concatenate(faces).astype(np.int32), uvs.astype(np.float32),
                 np.concatenate(face_uvs).astype(np.int32))  # fmt: skip
+
+
+def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:
+    """Vertex indices of each open boundary loop of faces (F, C) (unordered)."""
+    edges, _ = boundary_edges(faces)
+    if len(edges) == 0:
+        return []
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rim, local = np.unique(edges, return_inverse=True)
+    local = local.reshape(edges.shape)
+    graph = coo_matrix((np.ones(len(local)), (local[:, 0], local[:, 1])),
+                       shape=(len(rim), len(rim)))  # fmt: skip
+    count, label = connected_components(graph, directed=False)
+    return [rim[label == k] for k in range(count)]
+
+
+def level_hems(mesh: Mesh, reach: float = 0.035, flat: float = 0.1) -> Mesh:
+    """The mesh with each nearly flat open edge (a hem, a cuff, a waist; not a scooped
+    neckline or an armhole) laid on its best-fit plane, the move fading out over ``reach``
+    m into the cloth: a cut that follows the helper mesh's faces wanders 5-12 mm about
+    that plane, a wavy hem. ``flat``: largest RMS distance from the plane, as a share of
+    the loop's mean radius, of a loop that is levelled."""
+    v = mesh.vertices.astype(np.float64)
+    shift = np.zeros_like(v)
+    ends: list[np.ndarray] = []
+    for loop in boundary_loops(mesh.faces):
+        p = v[loop]
+        centre = p.mean(axis=0)
+        normal = np.linalg.svd(p - centre)[2][2]
+        off = (p - centre) @ normal
+        radius = np.linalg.norm(p - centre, axis=1).mean()
+        if len(loop) < 8 or np.sqrt(np.mean(off**2)) > flat * radius:
+            continue
+        shift[loop] = -off[:, None] * normal
+        ends.append(loop)
+    if not ends:
+        return mesh
+    rim = np.concatenate(ends)
+    distance, nearest = cKDTree(v[rim]).query(v)
+    t = np.clip(1 - distance / reach, 0, 1)
+    moved = v + (t * t * (3 - 2 * t))[:, None] * shift[rim[nearest]]
+    return Mesh(moved.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)

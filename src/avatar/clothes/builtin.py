@@ -22,6 +22,7 @@ from avatar.clothes.authoring import (
     covered_skin,
     cut,
     join,
+    level_hems,
     orient_outward,
     with_box_uvs,
 )
@@ -61,12 +62,12 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
     garment is laid at (``tailoring.hug_skin``) instead of ``ease`` off the shell."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
-    mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX)
+    mesh = level_hems(cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX))
     if snug is not None:
         points = tailoring.hug_skin(body, mesh.vertices.astype(np.float64), snug)
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
-    if band:
-        mesh = banded(mesh, band)
+    if band:  # the band's inner edge (a staircase of whole faces) levelled as the hem is
+        mesh = level_hems(banded(mesh, band), reach=0.012)
     # A snug garment follows the skin itself on every body (the shell stands off the skin
     # by different amounts on different bodies: bound to it, the seat sagged again).
     return bound(body, mesh, body.skin_faces if snug is not None else faces)
@@ -109,14 +110,15 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     mesh = cut(body, faces, bottom(length)(ff, body.marks), ease, relax=RELAX)
-    mesh = Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang, taper=taper)
-                .astype(np.float32), mesh.faces)  # fmt: skip
+    mesh = level_hems(Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang,
+                                                   taper=taper).astype(np.float32), mesh.faces))
     panels = tailoring.Panels(mesh, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
     band = 0.04 if kind == "jeans" else 0.035
     h = tailoring.heights(mesh, body.marks, band)
     top = h.top
     mesh = banded(panels.textured(), lambda p: np.where(p[:, 2] > top - 0.05, band, 0.02),
                   0.002)  # fmt: skip
+    mesh = level_hems(mesh, reach=0.012)  # the bands' inner edges, as the hems
     marks = (tailoring.jeans_marks if kind == "jeans" else tailoring.trouser_marks)(panels, h)
     piece = join([bound(body, mesh, faces), tailoring.belt_loops(body, mesh, h, faces)])
     return replace(piece, layout=tailoring.layout(panels, marks, thread))
