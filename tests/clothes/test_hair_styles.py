@@ -58,3 +58,16 @@ def test_every_hair_style_keeps_to_a_vertex_budget(body):
               if s.category == "hair"}  # fmt: skip
     assert counts["hair-short"] <= 10_000
     assert max(counts.values()) <= 16_000, counts
+
+
+def test_long_hair_is_locks_not_one_sheet(body):
+    """Long hair's cards are turned about their paths, each its own way (their faces not
+    all lying on one surface), and wander sideways as locks do."""
+    mesh = hair.long_cards(body).mesh
+    cards = mesh.vertices.reshape(-1, 2, 10, 3).astype(np.float64)
+    middle = cards[:, :, 6].mean(axis=1)
+    across = cards[:, 1, 6] - cards[:, 0, 6]
+    across /= np.linalg.norm(across, axis=1, keepdims=True)
+    outward = body.outward(middle)
+    tilt = np.abs(np.einsum("nd,nd->n", across, outward))  # 0: lying flat on the surface
+    assert np.percentile(tilt, 75) > 0.2

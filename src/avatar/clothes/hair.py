@@ -325,8 +325,8 @@ def _resample(line: np.ndarray, samples: int) -> np.ndarray:
 
 def long_cards(
     body: AuthoringBody,
-    count: int = 300,
-    width: float = 0.03,
+    count: int = 360,
+    width: float = 0.024,
     layers=(0.004, 0.024),
     seed: int = 1,
     samples: int = 10,
@@ -334,6 +334,10 @@ def long_cards(
     """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
     stacked at random heights between ``layers`` (m) off the guides, of random length.
 
+    Locks, not a sheet: each card wanders sideways down its length and is turned about
+    its own path by a random angle (up to ~25 degrees), so the cards catch the light
+    differently and their edges show between one another (300 cards 3 cm wide, all lying
+    flat on one surface, read as one flat sheet of painted strands).
     Neighbours are only blended around the back and sides: never across the face.
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
     """
@@ -357,7 +361,13 @@ def long_cards(
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
-    return _card_piece(body, path, normal, width, rng)
+    along = np.gradient(path, axis=1)
+    along /= np.maximum(np.linalg.norm(along, axis=-1, keepdims=True), 1e-9)
+    sideways = np.cross(along, normal)
+    path = path + rng.normal(0, 0.006, (count, 1, 1)) * t**1.5 * sideways  # wandering locks
+    turn = rng.uniform(-0.45, 0.45, count)[:, None, None]
+    facing = np.cos(turn) * normal + np.sin(turn) * sideways
+    return _card_piece(body, path, facing, width, rng)
 
 
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
