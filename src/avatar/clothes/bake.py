@@ -305,7 +305,13 @@ class _Job:
 
     def _deep(self, window: _Window, i: int, t: int, moved: np.ndarray, points: np.ndarray,
               suspect: np.ndarray, skin: collision.PosedBody):  # fmt: skip
-        """(rows of ``moved`` more than ``bound`` inside, the skin query of those rows),"""
+        """(rows of ``moved`` more than ``bound`` inside, where to put them (D, 3)), measuring
+        the exact points' clearance of suspects not yet measured.
+
+        A deep vertex goes MARGIN outside the skin along its normal, the least move out;
+        where that lands inside another part of the body (cloth caught between arm and
+        chest) it goes to its exact position instead, when that one is out.
+        """
         clearance = window.clearance[i][t]
         unknown = suspect[np.isnan(clearance[moved[suspect]])]
         if len(unknown):
@@ -315,8 +321,13 @@ class _Job:
         if not len(suspect):
             return suspect, np.zeros((0, 3), np.float32)
         q = skin.query(points[suspect], k=6)
-        deep = np.flatnonzero(q.distance < -self.bound)
-        return suspect[deep], q.closest[deep] + MARGIN * q.normal[deep]
+        deep = suspect[q.distance < -self.bound]
+        pushed = (q.closest + MARGIN * q.normal)[q.distance < -self.bound]
+        if len(deep):
+            caught = skin.query(pushed, k=6).distance < -self.bound
+            caught &= clearance[moved[deep]] >= -self.bound + SLACK
+            pushed[caught] = window.exact[i][t, moved[deep[caught]]]
+        return deep, pushed
 
 
 def _with_bases(part: MeshPart, windows: list[range], bases: list[Basis | None], bound: float,

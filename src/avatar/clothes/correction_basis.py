@@ -16,6 +16,7 @@ import numpy as np
 ERROR_BOUND = 5e-4  # m: worst distance of a played-back garment vertex from its exact frame
 MAX_BASIS = 16  # correction shapes a garment segment gets (fewer when they meet ERROR_BOUND)
 LIMIT = 64  # most shapes a garment gets when ERROR_BOUND needs more than MAX_BASIS
+UNMOVED = 1e-5  # m: residual rows shorter than this are round-off, not push-outs
 GROW_BOUND = 1e-4  # m: how closely ``grow``'s shapes play the mended frames' push-outs
 HEAVY = 100.0  # weight of pushed-out vertices in a frame's least-squares weights
 
@@ -105,6 +106,9 @@ def grow(basis: Basis, corrections: Corrections, frames: list[int], most: int) -
         at = np.searchsorted(basis.moved, corrections.rows[t])
         residual[r, at] = corrections.deltas[t]
         residual[r] -= basis.moved_delta(t)
+    # Elsewhere the target is the played frame, up to float32 round-off: zero it, so the
+    # shapes stay as sparse as the push-outs (a morph target stores only its non-zero rows).
+    residual[np.linalg.norm(residual, axis=2) < UNMOVED] = 0.0
     shapes, weights, _ = fit_basis(residual, GROW_BOUND, most)
     out = np.zeros((len(basis.weights), len(basis.shapes) + len(shapes)), dtype=np.float32)
     out[:, : len(basis.shapes)] = basis.weights
