@@ -35,11 +35,13 @@ is only one way out of it. So the bake plays every frame back as a viewer will
 out (``MARGIN`` beyond it). The first ``REFITS`` checks solve the frame's weights again with
 them weighted ``HEAVY`` and refit the shapes to the mended frames (low-rank by
 construction); the later ones give the frames they mend a few sparse shapes of their own
-that play the push-outs (``grow``, at most ``GROW`` a check), which converges: only those
-frames change, so only those are checked again. A check measures only vertices that can be
-that deep: the distance to the skin changes at most as much as the point moves, so a
-played-back vertex closer to its exact position than that position's clearance (+ bound) is
-skipped. What is left is measured in docs/benchmarks.md.
+that play the push-outs (``correction_basis.grow``, at most ``GROW`` a check, the last one
+as many as it takes), which converges: only those frames change, so only those are checked
+again (cloth caught between two body parts can still be left inside). A check measures
+only vertices that can be that deep: the distance to the skin changes at most as much as the
+point moves, so a played-back vertex closer to its exact position than that position's
+clearance (+ bound) is skipped. The basis maths (fit, weights, grow, morph targets) is
+``correction_basis``; what is left is measured in docs/benchmarks.md.
 
     parts, weights = bake(human.body, human.outfit, animation, human.parts())
     gltf.write(path, parts, human.skeleton, {"walk": animation}, morph_weights={"walk": weights})
