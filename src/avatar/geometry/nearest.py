@@ -16,6 +16,12 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 from scipy.spatial import cKDTree
 
+# pykdtree's OpenMP threads would otherwise spin for a while after every search: with
+# other work on the machine (a render, a second worker, other programs) the spinning takes
+# the cores from it and searches ran 2-5x slower. Sleeping threads cost microseconds per
+# search. Read once, when OpenMP loads; a value the user set is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 try:
     from pykdtree.kdtree import KDTree
 except ImportError:  # pragma: no cover - depends on the environment
