@@ -235,18 +235,18 @@ def test_knit_rows_turn_over_only_at_the_shoulder_ridge(name):
 # ---------------------------------------------------------------------------- dress
 
 
-def test_no_skin_shows_through_the_dress_mid_stride():
-    """The forward knee pushed into the skirt between its vertices (each kept clear of
-    the skin, the faces between them 3-4 cm wide): the rendered triangles of both cloth
-    layers dipped 1.2 and 2.5 mm into the knee, a speck of skin on the skirt. The dress's
-    outer surface, sampled densely on both triangulations of every quad, stays outside
-    the skin through the stride."""
+def _outer_surface_clearance(human: Human, frames, keep=None) -> list[float]:
+    """Per walk frame, the least signed distance (m) from the skin of the first garment's
+    outer cloth layer as rendered: dense samples on both triangulations of every quad
+    (``keep``: a (F,) mask of those faces, by their rest positions)."""
     from avatar.geometry import collision
 
-    human = Human({"gender": 0.0, "age": 0.5, "weight": 0.5}).dressed("dress")
     fitted = human.outfit.garments[0]
     count = len(fitted.garment.mesh.vertices)
-    faces = fitted.mesh.faces[np.all(fitted.mesh.faces >= count, axis=1)]  # the outer layer
+    outer = np.all(fitted.mesh.faces >= count, axis=1)
+    if keep is not None:
+        outer &= keep(fitted.mesh.vertices[fitted.mesh.faces].mean(axis=1))
+    faces = fitted.mesh.faces[outer]
     base = human.model.base
     surface = collision.skin_surface(base.faces[base.face_groups["body"]])
     t = np.linspace(0, 1, 7)
@@ -254,19 +254,53 @@ def test_no_skin_shows_through_the_dress_mid_stride():
     inside = a + b <= 1
     a, b = a[inside], b[inside]
     walk = human.walk(seconds=1.0, fps=24)
-    for frame in (4, 6, 8):
+    out = []
+    for frame in frames:
         world = kinematics.forward(human.skeleton, walk.rotations[frame:frame + 1],
                                    walk.translations[frame:frame + 1])  # fmt: skip
         matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
         body = skinning.linear_blend(human.vertices, human.weights, matrices)
-        v = human.outfit.frame(body, matrices, exact=True)[0].astype(np.float64)
-        corners = v[faces]
+        corners = human.outfit.frame(body, matrices, exact=True)[0].astype(np.float64)[faces]
+        least = np.inf
         for tri in ((0, 1, 2), (0, 2, 3), (0, 1, 3), (1, 2, 3)):
             p0, p1, p2 = (corners[:, k] for k in tri)
             points = (p0[:, None] + a[None, :, None] * (p1 - p0)[:, None]
                       + b[None, :, None] * (p2 - p0)[:, None]).reshape(-1, 3)  # fmt: skip
             q = collision.query(body[:13380].astype(np.float64), surface, points, k=4)
-            assert q.distance.min() > 0.0, (frame, tri, q.distance.min())
+            least = min(least, float(q.distance.min()))
+        out.append(least)
+    return out
+
+
+def test_no_skin_shows_through_the_dress_mid_stride():
+    """The forward knee pushed into the skirt between its vertices (each kept clear of
+    the skin, the faces between them 3-4 cm wide): the rendered triangles of both cloth
+    layers dipped 1.2 and 2.5 mm into the knee, a speck of skin on the skirt. The dress's
+    outer surface stays outside the skin through the stride."""
+    human = Human({"gender": 0.0, "age": 0.5, "weight": 0.5}).dressed("dress")
+    clearance = _outer_surface_clearance(human, (4, 6, 8))
+    assert min(clearance) > 0.0, clearance
+
+
+@pytest.mark.parametrize(("name", "params"), [
+    ("swimsuit", {"gender": 0.0, "age": 0.3, "weight": 0.35}),
+    ("leggings", {"gender": 0.0, "age": 0.95, "weight": 0.6}),
+])  # fmt: skip
+def test_no_skin_shows_through_snug_garments_from_behind_mid_stride(name, params):
+    """Laid closer to the skin, a swimsuit's seat and leggings' calves showed specks of
+    skin mid-stride (2 mm into the outer layer between vertices): the seat, the backs of
+    the thighs and calves stay covered (the crotch's pinched fold aside)."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    human = Human(params).dressed(name)
+    hip = AuthoringBody(human.body).marks.hip[0]
+
+    def behind(c):  # the swimsuit's gusset, pinched between the thighs, aside
+        gusset = (np.abs(c[:, 0]) < 0.06) & (c[:, 2] < hip[2] - 0.02) & (name == "swimsuit")
+        return (c[:, 1] > hip[1] + 0.02) & ~gusset
+
+    clearance = _outer_surface_clearance(human, (6, 18), behind)
+    assert min(clearance) > 0.0, clearance
 
 
 # ---------------------------------------------------------------------------- hems

@@ -179,7 +179,10 @@ def strapped(hem: float, armhole: float = 0.062, front: float = 0.12, back: floa
     return keep
 
 
-SNUG = 0.0025  # m off the skin for stretch garments (lycra): the fitting's clearance and a bit
+# Stretch garments (lycra) lie SNUG m off the skin, as SNUG_THICKNESS m of cloth: closer,
+# or thinner, and mid-stride the skin bulged through between their vertices (specks of
+# skin on the seat and the calves).
+SNUG, SNUG_THICKNESS = 0.004, 0.003
 tank = strapped(0.04)
 # A one-piece: high-cut legs (the torso faces end at the groin), narrow straps, deep neck.
 swimsuit = strapped(-0.15, armhole=0.072, front=0.15, back=0.13)
@@ -498,10 +501,10 @@ SPECS = [
     Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
     Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow", 0.92), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
     Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
-    Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015, snug=SNUG), "lycra", "black", 0.001, 25, ("leggings", "sport")),  # noqa: E501
+    Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015, snug=SNUG), "lycra", "black", SNUG_THICKNESS, 25, ("leggings", "sport")),  # noqa: E501
     Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",), clearance=0.006),  # noqa: E501
     Spec("dress", "dresses", _dress, "cotton", "teal", DRESS_THICKNESS, 38, ("dress",), clearance=DRESS_CLEARANCE),  # noqa: E501
-    Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001, snug=SNUG), "lycra", "sky", 0.001, 25, ("swimwear", "one-piece")),  # noqa: E501
+    Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001, snug=SNUG), "lycra", "sky", SNUG_THICKNESS, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "dark brown", "dark brown")),  # noqa: E501
     Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "black", "black", "charcoal")),  # noqa: E501
