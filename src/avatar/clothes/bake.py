@@ -160,6 +160,7 @@ class _Window:
     exact: list[np.ndarray]
     clearance: list[np.ndarray]
     corrections: list[Corrections]
+    checked: bool = False  # whether a check ran (the first measures no clearance)
 
 
 @dataclass
@@ -279,6 +280,7 @@ class _Job:
                     solve_weights(basis, window.corrections[i], t, heavy[i][t])
                 mended[i].add(t)
                 pushed += len(deep)
+        window.checked = True
         log.info("played-back check: %d garment vertex-frames pushed out", pushed)
         return mended
 
@@ -316,7 +318,7 @@ class _Job:
         """
         clearance = window.clearance[i][t]
         unknown = suspect[np.isnan(clearance[moved[suspect]])]
-        if len(unknown):
+        if len(unknown) and window.checked:  # a first check (often the only one) skips it
             exact = window.exact[i][t, moved[unknown]]
             clearance[moved[unknown]] = skin.query(exact, k=6).distance
             suspect = self._suspects(window, i, t, moved, points)
