@@ -8,6 +8,8 @@
    (efficiency = rate(2) / (2 * rate(1)), the single worker on one core's share, as each
    of the two has: its threads limited and the process held to that many cores), and the
    speed-up of 2 workers over 1 worker on every core;
+   and the machine's own ceiling, measured in the same run: two CPU-bound loops on two
+   cores at once against one alone (a VM's two cores may share one physical core);
 3. engines: local vs Ray (a local cluster), same samples;
 4. --rss N: the worker's resident memory over N samples (one process, no recycling), the
    curve printed every 10 samples: it should stay within 10% of its value after 50.
@@ -81,6 +83,32 @@ def rate(args, workers: int, engine: str, folder: Path, threads: int | None = No
     return args.count / (time.perf_counter() - start)
 
 
+def _spin(core: int) -> float:
+    """Seconds of a fixed pure-Python loop on one core (no memory traffic to speak of)."""
+    os.sched_setaffinity(0, {core})
+    start, total = time.perf_counter(), 0
+    for i in range(12_000_000):
+        total += i * i
+    return time.perf_counter() - start
+
+
+def machine_ceiling(repeat: int = 3) -> float:
+    """What this machine gives two busy processes: the rate of each of two loops on two
+    cores at once over one loop alone (1.0 on two real cores; less where the cores share a
+    physical core or the host throttles). The workers' efficiency cannot exceed it."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    cores = sorted(os.sched_getaffinity(0))[:2]
+    ratios = []
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        for _ in range(repeat):
+            alone = pool.submit(_spin, cores[0]).result()
+            both = [f.result() for f in [pool.submit(_spin, c) for c in cores]]
+            ratios.append(alone / max(both))
+    return sorted(ratios)[len(ratios) // 2]
+
+
 def rss_curve(args, folder: Path) -> list[tuple[int, float]]:
     """(samples done, RSS MB) of this process rendering ``args.rss`` samples."""
     c = _config(args, args.rss)
@@ -134,10 +162,14 @@ def _throughput(args, root: Path) -> None:
     one_share = rate(args, 1, "local", root / "w1s", threads=share)
     one = rate(args, 1, "local", root / "w1")
     two = rate(args, 2, "local", root / "w2")
+    ceiling = machine_ceiling()
     print(f"local engine: 1 worker on {share} thread(s) {one_share:.3f} samples/s, "
           f"2 workers on {share} each {two:.3f} samples/s: efficiency "
           f"{two / (2 * one_share):.2f}; 1 worker on every core {one:.3f} samples/s: "
           f"2 workers {two / one:.2f}x that")  # fmt: skip
+    print(f"machine ceiling (anchor): two CPU-bound loops on two cores each run at "
+          f"{ceiling:.2f} of one alone; the workers' efficiency is "
+          f"{two / (2 * one_share) / ceiling:.2f} of that")  # fmt: skip
     if not args.skip_ray:
         ray = rate(args, 2, "ray", root / "ray")
         print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "

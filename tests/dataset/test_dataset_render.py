@@ -337,3 +337,35 @@ def test_a_worker_hands_freed_heap_pages_back_after_a_sample():
     assert held > before - 50  # freed, yet still resident
     assert after < held - 100, (before, held, after)
     del pinned
+
+
+def _held_cores() -> tuple[int, tuple[int, ...]]:
+    import os
+    import time
+
+    time.sleep(0.3)  # both workers alive at once
+    return os.getpid(), tuple(sorted(os.sched_getaffinity(0)))
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "sched_setaffinity"), reason="Linux only")
+def test_workers_are_held_to_disjoint_shares_of_the_cores():
+    """Two real spawned workers (recycled after every task, as ``recycle_every`` does) each
+    run on their own half of the cores, and a recycled worker takes the share left free."""
+    import multiprocessing
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from avatar.dataset import runner
+
+    cores = sorted(os.sched_getaffinity(0))
+    if len(cores) < 2:
+        pytest.skip("needs two cores")
+    context = multiprocessing.get_context("spawn")
+    slots = context.Array("i", 2)
+    pool = ProcessPoolExecutor(2, mp_context=context, max_tasks_per_child=1,
+                               initializer=runner.hold_to_share, initargs=(slots,))  # fmt: skip
+    with pool:
+        seen = [f.result(timeout=120) for f in [pool.submit(_held_cores) for _ in range(6)]]
+    halves = {tuple(cores[0::2]), tuple(cores[1::2])}
+    assert {held for _, held in seen} == halves  # each task on one half, both halves used
+    assert len({pid for pid, _ in seen}) == 6  # every task in a new worker

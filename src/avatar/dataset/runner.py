@@ -120,8 +120,10 @@ def _local(config: Config, out: Path, todo: list[int], workers: int) -> Iterable
 def _pooled(config: Config, out: Path, todo: list[int], workers: int,
             threads: int) -> Iterable[Result]:  # fmt: skip
     context = multiprocessing.get_context("spawn")  # a fresh Blender per worker
+    slots = context.Array("i", max(1, workers))  # the pid holding each share of the cores
     pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=context,
-                               max_tasks_per_child=config.render.recycle_every)  # fmt: skip
+                               max_tasks_per_child=config.render.recycle_every,
+                               initializer=hold_to_share, initargs=(slots,))  # fmt: skip
     pending: dict[Future, int] = {}
     queue = list(reversed(todo))
     try:
@@ -138,6 +140,36 @@ def _pooled(config: Config, out: Path, todo: list[int], workers: int,
                     yield index, None, f"worker failed: {exc.__class__.__name__}: {exc}"
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def hold_to_share(slots) -> None:
+    """Worker initializer: hold this process to a share of the cores no other live worker
+    holds (Linux; elsewhere nothing). ``slots``: a shared array, one entry per worker, of
+    the pid holding that share (0: none). Told how many threads to start, Cycles, OpenMP and
+    OpenBLAS still ran on every core, as does Blender's task scheduler (scene sync, BVH
+    builds), so two workers took time from each other's renders; held to disjoint cores,
+    every pool a worker starts sizes itself to its share. A recycled worker takes the share
+    its predecessor left."""
+    if len(slots) < 2 or not hasattr(os, "sched_setaffinity"):
+        return
+    cores = sorted(os.sched_getaffinity(0))
+    if len(cores) < len(slots):
+        return
+    with slots.get_lock():
+        free = [i for i, pid in enumerate(slots) if pid == 0 or not _alive(pid)]
+        share = free[0] if free else os.getpid() % len(slots)
+        slots[share] = os.getpid()
+    os.sched_setaffinity(0, cores[share :: len(slots)])
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process took the pid: not a worker of ours
+        return False
+    return True
 
 
 # Native thread pools a worker's libraries start with one thread per core unless told.
