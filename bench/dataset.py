@@ -26,6 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from avatar.dataset import config as dataset_config
 from avatar.dataset import people, runner, sampling, worker
 
@@ -149,8 +151,13 @@ def main() -> int:
         if args.rss:
             curve = rss_curve(args, root / "rss")
             base = next((mb for n, mb in curve if n >= 50), curve[0][1])
+            late = [(n, mb) for n, mb in curve if n >= 50]
+            x, y = np.array(late, dtype=float).T
+            slope = np.polyfit(x, y, 1)[0] * 100 if len(late) > 2 else 0.0
             print(f"RSS after {curve[-1][0]} samples: {curve[-1][1]:.0f} MB, "
-                  f"{100 * (curve[-1][1] / base - 1):+.1f}% of the value after 50")
+                  f"{100 * (curve[-1][1] / base - 1):+.1f}% of the value after 50; highest "
+                  f"after 50: {100 * (max(mb for _, mb in late) / base - 1):+.1f}%; trend "
+                  f"{slope:+.1f} MB per 100 samples")  # fmt: skip
     return 0
 
 
