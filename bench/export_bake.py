@@ -3,6 +3,7 @@
     .venv/bin/python bench/export_bake.py [--seconds 10] [--fps 30] [--wear tshirt,jeans,...]
     .venv/bin/python bench/export_bake.py --clip CLIP.bvh   # e.g. CMU 01_01 (2,752 frames)
     .venv/bin/python bench/export_bake.py --clip CLIP.bvh --frames 1000:1500   # an excerpt
+    ... --keep DIR   # keep both GLBs in DIR (to inspect a frame that goes inside)
 
 One dressed body (the default human, game_engine rig), the built-in walk or a BVH clip
 retargeted onto it. In the same run: the plain skinned GLB (``resolve_garments=False``) and
@@ -10,8 +11,9 @@ the baked one (a few correction shapes per garment and segment of the clip drive
 per-frame weights, ``avatar.clothes.bake``): export time, the bake's time per frame
 (``Outfit.frame(exact=True)`` alone as the anchor), file sizes, correction shapes per
 garment, and the worst garment penetration played back from each file (morphs blended with
-the keyed weights, then the file's skin and animation: what a viewer shows). Prints a table
-for docs/benchmarks.md.
+the keyed weights, then the file's skin and animation: what a viewer shows), naming each
+baked frame more than 1 mm inside (garment, vertex, depth). Prints a table for
+docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -56,9 +58,9 @@ def _frame_anchor(human, clip, frames: int) -> float:
     return float(np.median(times))
 
 
-def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
-    """(worst depth (m) of a garment vertex inside the body over every frame, frames with
-    any vertex more than 1 mm inside), played back from the file alone."""
+def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, list[str]]:
+    """(worst depth (m) of a garment vertex inside the body over every frame, one line per
+    frame with any vertex more than 1 mm inside), played back from the file alone."""
     from avatar.geometry import collision
     from avatar.human import BODY_PART_GROUPS
     from avatar.io import gltf
@@ -70,22 +72,24 @@ def _played_penetration(path: Path, faces: np.ndarray) -> tuple[float, int]:
     world = kinematics.forward(file.skeleton, clip.rotations, clip.translations)
     parts = {p.name: p for p in file.parts}
     garments = [p for n, p in parts.items() if n not in BODY_PART_GROUPS and "_LOD" not in n]
-    worst, bad = 0.0, 0
+    worst, bad = 0.0, []
     for t in range(clip.frames):
         matrices = kinematics.skinning_matrices(file.skeleton, world[t : t + 1])[0]
         skin = skinning.SkinWeights(*parts["body"].skin)
         body = skinning.linear_blend(parts["body"].mesh.vertices, skin, matrices)
-        frame_worst = 0.0
+        frame_worst, where = 0.0, ""
         for g in garments:
             rest = g.mesh.vertices.astype(np.float64)
             for k, delta in enumerate(g.morphs.values()):
                 if g.name in keyed and keyed[g.name][t, k]:
                     rest = rest + keyed[g.name][t, k] * delta
             posed = skinning.linear_blend(rest, skinning.SkinWeights(*g.skin), matrices)
-            frame_worst = max(
-                frame_worst, float(collision.penetration(body, faces, posed)[1].max())
-            )
-        worst, bad = max(worst, frame_worst), bad + (frame_worst > 1e-3)
+            depth = collision.penetration(body, faces, posed)[1]
+            if depth.max() > frame_worst:
+                frame_worst, where = float(depth.max()), f"{g.name} vertex {depth.argmax()}"
+        worst = max(worst, frame_worst)
+        if frame_worst > 1e-3:
+            bad.append(f"frame {t}: {where} {frame_worst * 1e3:.1f} mm inside")
     return worst, bad
 
 
@@ -110,7 +114,10 @@ def main(argv: list[str]) -> None:
     dress = time.perf_counter() - start
     anchor = _frame_anchor(human, clip, min(20, clip.frames))
     faces = human.model.base.faces[human.model.base.face_groups["body"]]
-    with tempfile.TemporaryDirectory() as tmp:
+    keep = _arg(argv, "--keep", "")
+    with tempfile.TemporaryDirectory() as scratch:
+        tmp = keep or scratch
+        Path(tmp).mkdir(parents=True, exist_ok=True)
         rows = {}
         for name, resolve in (("plain", False), ("baked", True)):
             path = Path(tmp) / f"{name}.glb"
@@ -137,8 +144,10 @@ def main(argv: list[str]) -> None:
           f"{', '.join(f'{k} {v}' for k, v in shapes.items())} | |")  # fmt: skip
     print(f"| worst garment depth inside the body, played back | {plain_in[0] * 1e3:.1f} mm | "
           f"{baked_in[0] * 1e3:.1f} mm | |")  # fmt: skip
-    print(f"| frames with a garment vertex > 1 mm inside | {plain_in[1]} | {baked_in[1]} | "
-          f"of {clip.frames} |")  # fmt: skip
+    print(f"| frames with a garment vertex > 1 mm inside | {len(plain_in[1])} | "
+          f"{len(baked_in[1])} | of {clip.frames} |")  # fmt: skip
+    for line in baked_in[1][:20]:
+        print(f"baked {line}")
 
 
 if __name__ == "__main__":

@@ -49,10 +49,14 @@ def test_info_lists_parameters(capsys, model):
     assert out.count("pca/") == 7
 
 
-@pytest.mark.parametrize(("flags", "resolve"), [([], True), (["--no-resolve-garments"], False)])
-def test_create_resolves_garments_in_animations_unless_told_not_to(tmp_path, model, monkeypatch,
-                                                                   flags, resolve):  # fmt: skip
-    """Dressed + animated glTF bakes the garment resolve by default, with a progress bar."""
+@pytest.mark.parametrize(("flags", "resolve", "segment"), [
+    ([], True, 300), (["--no-resolve-garments"], False, 300), (["--bake-segment", "120"], True, 120)
+])  # fmt: skip
+def test_create_resolves_garments_in_animations_unless_told_not_to(
+    tmp_path, model, monkeypatch, flags, resolve, segment
+):
+    """Dressed + animated glTF bakes the garment resolve by default, with a progress bar, in
+    segments of at most 300 frames unless told otherwise."""
     import avatar.export
 
     calls = []
@@ -62,6 +66,7 @@ def test_create_resolves_garments_in_animations_unless_told_not_to(tmp_path, mod
     assert cli.main(argv) == 0
     ((args, kwargs),) = calls
     assert kwargs["resolve_garments"] is resolve and kwargs["progress"] is True
+    assert kwargs["bake_segment"] == segment
     assert args[0].recipe.clothes == ("tshirt",) and args[2].frames == 8
 
 
@@ -71,6 +76,17 @@ def _one_line_error(capsys) -> str:
     assert len(err) == 1 and err[0].startswith("avatar: error: "), err
     assert "Traceback" not in err[0]
     return err[0]
+
+
+@pytest.mark.parametrize("segment", ["0", "-2", "1.5", "many"])
+def test_create_refuses_a_bake_segment_under_one_frame_as_a_usage_error(tmp_path, capsys,
+                                                                        segment):  # fmt: skip
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(["create", "--wear", "tshirt", "--motion", "walk", "--bake-segment", segment,
+                  "-o", str(tmp_path / "w.glb")])  # fmt: skip
+    assert exit_.value.code == 2
+    assert "--bake-segment" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize("fps", ["-5", "0", "nan", "inf", "fast"])

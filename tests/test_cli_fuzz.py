@@ -116,6 +116,7 @@ def _command(draw, folder: Path) -> tuple[list[str], list[Path]]:
             ("--set", st.builds(lambda n, v: f"{n}={v}", _NAMES, _NUMBERS)),
             ("--measure", st.builds(lambda n, v: f"{n}={v}", _NAMES, _NUMBERS)),
             ("--fps", _NUMBERS),
+            ("--bake-segment", pick(["0", "-3", "x", "2.5", "1"])),
             ("--frames", pick(["0:2", "5:1", "x", "::", "-3:"])),
             ("--motion", pick([str(folder / "in.bvh"), "missing.bvh", "walk", "run"])),
             ("--pose", pick([str(folder / "in.bvh"), "nope", str(folder / "in.mhm")])),

@@ -130,6 +130,7 @@ def _gltf(
     max_influences: int = MAX_INFLUENCES,
     texture_size: int | None = None,
     lods: int = 0,
+    bake_segment: int = bake.SEGMENT,
     **_: Any,
 ) -> None:
     from avatar.io import gltf  # pygltflib: not in every Blender's Python, only glTF needs it
@@ -141,7 +142,8 @@ def _gltf(
     weights: dict[str, np.ndarray] = {}
     if resolve_garments and animation is not None and human.recipe.clothes:
         parts, weights = bake.bake(human.body, human.outfit, animation, parts, progress,
-                                   max_influences=max_influences)  # fmt: skip
+                                   max_influences=max_influences,
+                                   segment=bake_segment)  # fmt: skip
     parts = texture_size_of(parts, texture_size)
     lod_parts, lod_weights = levels_of_detail(parts, lods, weights)
     keyed = {animation_name or "animation": weights | lod_weights} if weights else {}
@@ -168,13 +170,15 @@ def _blender(
     progress: bool = False,
     hide_covered: bool | None = None,
     expressions: bool = False,
+    bake_segment: int = bake.SEGMENT,
     **_: Any,
 ) -> None:
     from avatar.blender import export as blender_export
     from avatar.blender import scene
 
     staged = character(human, animation, resolve_garments=resolve_garments, progress=progress,
-                       hide_covered=hide_covered, expressions=expressions)  # fmt: skip
+                       hide_covered=hide_covered, expressions=expressions,
+                       bake_segment=bake_segment)  # fmt: skip
     scene.clear_scene()
     built = scene.build_character(staged)
     blender_export.export(path, [built.root, *built.parts])
@@ -223,6 +227,7 @@ def save(
     max_influences: int = MAX_INFLUENCES,
     texture_size: int | None = None,
     lods: int = 0,
+    bake_segment: int = bake.SEGMENT,
 ) -> Path:
     """Write ``human`` (posed/animated by ``animation`` when given) to ``path``.
 
@@ -239,6 +244,9 @@ def save(
         correction morph targets (shape keys) per garment driven by per-frame weights (a
         weights channel; a shape-key action in Blender's formats), so viewers show garments
         out of the body (``avatar.clothes.bake``). False: plain skinned garments.
+    bake_segment: the most frames one set of correction shapes holds (default 300); a
+        longer clip is cut into equal segments with their own shapes, so the file grows
+        linearly with the clip. Longer segments: fewer, fuller sets of shapes.
     progress: show a progress bar over long work (the garment bake).
     max_influences: glTF: joints per vertex, 8 or 4 (three.js and engines reading JOINTS_0).
     texture_size: glTF/OBJ: the longest texture side in px (e.g. 512, 1024, 2048); default:
@@ -254,11 +262,13 @@ def save(
     writer = WRITERS.get(path.suffix.lower())
     if writer is None:
         raise AvatarError(f"{path}: unknown output format; use one of {', '.join(WRITERS)}")
+    if bake_segment < 1:  # checked before any work, not deep inside the bake
+        raise ParameterError(f"bake segment of {bake_segment} frames: use at least 1")
     path.parent.mkdir(parents=True, exist_ok=True)
     writer(human, path, animation, expressions=expressions, hide_covered=hide_covered,
            animation_name=animation_name, rest=rest, resolve_garments=resolve_garments,
            progress=progress, max_influences=max_influences, texture_size=texture_size,
-           lods=lods)  # fmt: skip
+           lods=lods, bake_segment=bake_segment)  # fmt: skip
     return path
 
 
@@ -286,6 +296,7 @@ def character(
     progress: bool = False,
     hide_covered: bool | None = None,
     expressions: bool = False,
+    bake_segment: int = bake.SEGMENT,
 ) -> Character:
     """The Blender bridge's record of ``human``: its parts (body, eyes, garments), skeleton,
     animation and recipe (stored on the character so the extension can regenerate it).
@@ -294,7 +305,7 @@ def character(
     frame's penetration resolve into each garment's few correction shape keys driven by
     per-frame values (``avatar.clothes.bake`` with Blender's Armature-modifier skinning), so
     garments stay out of the body; ``progress`` shows a bar over those frames.
-    hide_covered, expressions: as ``save`` (the same parts as the files).
+    hide_covered, expressions, bake_segment: as ``save`` (the same parts as the files).
     """
     from avatar.blender.scene import Character
 
@@ -303,7 +314,8 @@ def character(
                        (x, y, z), human.to_recipe())  # fmt: skip
     if resolve_garments and animation is not None and human.recipe.clothes:
         parts, weights = bake.bake(human.body, human.outfit, animation, list(staged.parts),
-                                   progress, skin=bake.vertex_group_skin)  # fmt: skip
+                                   progress, skin=bake.vertex_group_skin,
+                                   segment=bake_segment)  # fmt: skip
         staged = replace(staged, parts=parts, morph_weights=weights)
     return staged
 

@@ -165,6 +165,28 @@ def test_segment_weights_are_zero_outside_their_frames(jumps):
         assert len(names) <= len(windows) * most  # linear in the segments
 
 
+def test_save_cuts_the_bake_into_the_segments_it_is_given(dressed, tmp_path):
+    """``avatar.save(..., bake_segment=n)`` bakes windows of at most n frames, each with its
+    own shapes keyed only on its frames; a segment under one frame is refused, nothing written."""
+    human, walk = dressed
+    n = -(-walk.frames // 2)
+    back = gltf.read(avatar.save(human, tmp_path / "two.glb", walk, bake_segment=n))
+    keyed = back.morph_weights["animation"]
+    windows = bake.segments(walk.frames, n)
+    assert len(windows) == 2
+    for part in back.parts[4:]:
+        if part.name not in keyed:
+            continue
+        names = list(part.morphs)
+        for s, window in enumerate(windows):
+            offset = names.index(f"{bake.BASIS_PREFIX}s{s:02d}_offset")
+            assert np.all(keyed[part.name][window.start : window.stop, offset] == 1.0)
+            assert not keyed[part.name][: window.start, offset].any()
+    with pytest.raises(AvatarError, match="bake segment of 0 frames"):
+        avatar.save(human, tmp_path / "none.glb", walk, bake_segment=0)
+    assert not (tmp_path / "none.glb").exists()
+
+
 def test_segments_cut_a_clip_into_equal_windows():
     assert bake.segments(300) == [range(0, 300)]
     assert bake.segments(2752) == [range(round(i * 275.2), round((i + 1) * 275.2))

@@ -16,7 +16,7 @@ from avatar.body import measures
 from avatar.body.model import BodyModel
 from avatar.cli import motion, paths, presets
 from avatar.cli.assignments import parse_assignments, parse_measurements
-from avatar.clothes import library
+from avatar.clothes import bake, library
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
 from avatar.motion.procedural import MOTIONS
@@ -85,6 +85,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="glTF/FBX/USD/.blend: skin garments plainly instead of baking each "
                    "frame's penetration resolve into morph targets / shape keys (faster, "
                    "smaller; garments may clip into the body)")  # fmt: skip
+    p.add_argument("--bake-segment", type=paths.positive_count, metavar="FRAMES",
+                   default=bake.SEGMENT,
+                   help="most frames one set of baked garment correction shapes holds; "
+                   "longer clips are cut into equal segments with their own shapes "
+                   f"(default {bake.SEGMENT})")  # fmt: skip
     p.add_argument("--render", metavar="PNG", help="also render a picture (needs bpy)")
     p.add_argument("-o", "--output", required=True, help="output file (.glb .gltf .obj .mhm ...)")
     p.set_defaults(run=run)
@@ -98,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
     path = export.save(human, args.output, animation, expressions=args.expressions,
                        hide_covered=_hiding(args), animation_name=name, rest=args.rest,
                        resolve_garments=args.resolve_garments, progress=True,
+                       bake_segment=args.bake_segment,
                        **presets.export_options(args.preset, max_influences=args.max_influences,
                                                 texture_size=args.texture_size,
                                                 lods=args.lods))  # fmt: skip

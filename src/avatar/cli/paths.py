@@ -26,6 +26,18 @@ def positive_number(text: str) -> float:
     return value
 
 
+def positive_count(text: str) -> int:
+    """argparse ``type`` for counts such as ``--bake-segment``: a whole number of at least 1
+    (a usage error, exit status 2, otherwise)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
+    return value
+
+
 def input_file(path: str | os.PathLike[str], what: str, hint: str = "") -> Path:
     """``path`` as a Path when it is an existing, readable file; else ParameterError
     (``hint`` ends the message: what else the option accepts)."""
