@@ -1,6 +1,7 @@
 """Dataset throughput and memory, against anchors measured in the same run.
 
     python bench/dataset.py [--count 16] [--resolution 256] [--samples 16] [--rss 0]
+                            [--repeat 1]
 
 1. label overhead: samples/s with every label against the anchor, a bare Cycles render of
    the same scenes (same people, camera, lights; RGB only), on one worker in-process;
@@ -10,6 +11,8 @@
    speed-up of 2 workers over 1 worker on every core;
    and the machine's own ceiling, measured in the same run: two CPU-bound loops on two
    cores at once against one alone (a VM's two cores may share one physical core);
+   ``--repeat N`` measures the three N times in turn and prints each round and the median
+   (a VM whose host shares its cores varies 10-30% from one run to the next);
 3. engines: local vs Ray (a local cluster), same samples;
 4. --rss N: the worker's resident memory over N samples (one process, no recycling), the
    curve printed every 10 samples: it should stay within 10% of its value after 50.
@@ -38,19 +41,21 @@ def _config(args, count: int, extra: str = "") -> dataset_config.Config:
                                 resolution=(args.resolution, args.resolution))  # fmt: skip
 
 
-def bare_vs_labelled(args, folder: Path) -> tuple[float, float]:
-    """(bare s/sample, labelled s/sample) in this process, same scenes, alternating."""
+def bare_vs_labelled(args, folder: Path) -> tuple[float, float, float]:
+    """(bare s/sample, labelled s/sample, median over the samples of labelled / bare) in
+    this process, same scenes, alternating (the median of the pairs is not thrown by one
+    sample that met a busy host)."""
     from avatar.blender import labels as blender_labels
 
     c = _config(args, args.count)
-    bare = labelled = 0.0
+    bare, labelled = np.zeros(args.count), np.zeros(args.count)
     worker.render_sample(c, args.count, folder)  # warm: garments built, Blender started
     for i in range(args.count):
         for step in ((0, 1) if i % 2 else (1, 0)):  # alternate which one meets warm caches
             start = time.perf_counter()
             if step:
                 worker.render_sample(c, i, folder)  # everything: people, RGB, labels, files
-                labelled += time.perf_counter() - start
+                labelled[i] = time.perf_counter() - start
                 continue
             spec = sampling.sample(c, i)
             posed = [people.pose_person(p) for p in spec.people]
@@ -58,8 +63,8 @@ def bare_vs_labelled(args, folder: Path) -> tuple[float, float]:
             stage = worker._STAGE[0]
             stage.build(items, spec.camera, spec.light, spec.background)
             stage.render_rgb(folder / "bare.png", spec.engine, spec.samples, False)
-            bare += time.perf_counter() - start
-    return bare / args.count, labelled / args.count
+            bare[i] = time.perf_counter() - start
+    return bare.mean(), labelled.mean(), float(np.median(labelled / bare))
 
 
 def rate(args, workers: int, engine: str, folder: Path, threads: int | None = None) -> float:
@@ -138,6 +143,7 @@ def main() -> int:
     parser.add_argument("--samples", type=int, default=16)
     parser.add_argument("--rss", type=int, default=0, help="samples for the memory curve")
     parser.add_argument("--skip-ray", action="store_true")
+    parser.add_argument("--repeat", type=int, default=1, help="rounds of the workers' rates")
     args = parser.parse_args()
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
     with tempfile.TemporaryDirectory() as tmp:
@@ -162,21 +168,28 @@ def main() -> int:
 
 
 def _throughput(args, root: Path) -> None:
-    bare, labelled = bare_vs_labelled(args, root / "inproc")
+    bare, labelled, paired = bare_vs_labelled(args, root / "inproc")
     print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
-          f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}%")
+          f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}% "
+          f"(median of the {args.count} pairs: {100 * (paired - 1):.0f}%)")  # fmt: skip
     share = max(1, (os.cpu_count() or 1) // 2)
-    one_share = rate(args, 1, "local", root / "w1s", threads=share)
-    one = rate(args, 1, "local", root / "w1")
-    two = rate(args, 2, "local", root / "w2")
-    ceiling = machine_ceiling()
-    print(f"local engine: 1 worker on {share} thread(s) {one_share:.3f} samples/s, "
-          f"2 workers on {share} each {two:.3f} samples/s: efficiency "
-          f"{two / (2 * one_share):.2f}; 1 worker on every core {one:.3f} samples/s: "
-          f"2 workers {two / one:.2f}x that")  # fmt: skip
-    print(f"machine ceiling (anchor): two CPU-bound loops on two cores each run at "
-          f"{ceiling:.2f} of one alone; the workers' efficiency is "
-          f"{two / (2 * one_share) / ceiling:.2f} of that")  # fmt: skip
+    rounds = []
+    for r in range(args.repeat):
+        one_share = rate(args, 1, "local", root / "w1s", threads=share)
+        one = rate(args, 1, "local", root / "w1")
+        two = rate(args, 2, "local", root / "w2")
+        ceiling = machine_ceiling()
+        rounds.append((two / (2 * one_share), ceiling, two / one))
+        print(f"round {r + 1}: local engine: 1 worker on {share} thread(s) {one_share:.3f} "
+              f"samples/s, 2 workers on {share} each {two:.3f} samples/s: efficiency "
+              f"{rounds[-1][0]:.2f}; 1 worker on every core {one:.3f} samples/s: 2 workers "
+              f"{rounds[-1][2]:.2f}x that; machine ceiling (anchor): two CPU-bound loops on "
+              f"two cores each run at {ceiling:.2f} of one alone", flush=True)  # fmt: skip
+    efficiency, ceiling, speedup = np.median(np.array(rounds), axis=0)
+    print(f"median of {len(rounds)} round(s): efficiency {efficiency:.2f} (goal >= 0.85), "
+          f"machine ceiling {ceiling:.2f}, 2 workers {speedup:.2f}x 1 worker on every core; "
+          f"efficiency / ceiling per round "
+          f"{', '.join(f'{e / c:.2f}' for e, c, _ in rounds)}")  # fmt: skip
     if not args.skip_ray:
         ray = rate(args, 2, "ray", root / "ray")
         print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
