@@ -71,3 +71,82 @@ def test_long_hair_is_locks_not_one_sheet(body):
     outward = body.outward(middle)
     tilt = np.abs(np.einsum("nd,nd->n", across, outward))  # 0: lying flat on the surface
     assert np.percentile(tilt, 75) > 0.2
+
+
+def test_long_hair_has_no_seam_down_the_back(body):
+    """Cards are blended between every pair of neighbouring guide curves, the two either
+    side of the back's midline too: no gap between the left and right cards there (it
+    was 7.7 mm wide at the tips, a dark line down the back)."""
+    centre, _ = hair.head_frame(body)
+    lines = hair.long_cards(body).mesh.vertices.reshape(-1, 2, 10, 3).mean(axis=1)
+    points = lines.reshape(-1, 3).astype(np.float64)
+    low = (points[:, 2] > 1.08) & (points[:, 2] < 1.25) & (points[:, 1] > centre[1])
+    x = np.sort(points[low & (np.abs(points[:, 0]) < 0.06), 0])
+    assert len(x) > 200 and np.diff(x).max() < 0.004
+
+
+def test_long_hair_bangs_are_narrow_strands(body):
+    """What hangs over the forehead is many strands a few millimetres wide, each tapering
+    to a point and thinned out by the texture's tips, not 2.5 cm paper strips."""
+    mesh = builtin.BY_NAME["hair-long"].make(body).mesh
+    centre, eye_z = hair.head_frame(body)
+    v = mesh.vertices.astype(np.float64)
+    f = mesh.faces
+    c = v[f].mean(axis=1)
+    over = ((c[:, 1] < centre[1] - 0.06) & (c[:, 2] > eye_z + 0.01) & (c[:, 2] < eye_z + 0.06)
+            & (np.abs(c[:, 0]) < 0.05))  # fmt: skip
+    # A face's width: the shorter of its two sides (the strands run down over 1-2 cm).
+    width = np.minimum(np.linalg.norm(v[f[:, 0]] - v[f[:, 1]], axis=1),
+                       np.linalg.norm(v[f[:, 1]] - v[f[:, 2]], axis=1))  # fmt: skip
+    assert over.sum() > 100  # was 30 faces of 17 wide cards
+    assert np.percentile(width[over], 90) < 0.006  # was 2 cm
+    # Their tips end on the texture's thinned-out strand tips (v near 0).
+    uv = mesh.uvs[mesh.face_uvs[over]].reshape(-1, 2)
+    assert np.percentile(uv[:, 1], 5) < 0.05
+
+
+def test_short_hair_turns_round_a_crown_whorl_and_lies_down(body):
+    """Seen from above, cards near the crown run round it (a whorl) rather than straight
+    out from it (a sea urchin: 13 degrees off straight out on average), and on top of the
+    head they leave the scalp at a shallow angle (a median 14 degrees over their first
+    half before)."""
+    centre, eye_z = hair.head_frame(body)
+    cards = hair.grow_cards(body, hair.flow_crown()).mesh.vertices
+    lines = cards.reshape(-1, 2, 3, 3).astype(np.float64).mean(axis=1)
+    root, middle, tip = lines[:, 0], lines[:, 1], lines[:, 2]
+    crown = centre + np.asarray(hair.CROWN_OFFSET)
+    seen = (tip - root)[:, :2]
+    out = (root - crown)[:, :2]
+    near = np.hypot(*out.T) < 0.05
+    cos = np.abs(np.einsum("nd,nd->n", seen, out)) / (
+        np.linalg.norm(seen, axis=1) * np.maximum(np.linalg.norm(out, axis=1), 1e-9)
+    )
+    assert near.sum() > 100
+    assert np.degrees(np.arccos(np.clip(cos[near], 0, 1))).mean() > 30
+    first = middle - root
+    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    rise = np.degrees(np.arcsin(np.einsum("nd,nd->n", first, body.outward(root))))
+    assert np.median(rise[root[:, 2] > eye_z + 0.08]) < 12
+
+
+def test_ponytail_is_a_full_bundle(body):
+    """Below the tie the tail is some 6 cm across (it was under 5: a narrow dark rope)."""
+    lines = hair.ponytail(body).mesh.vertices.reshape(-1, 2, 13, 3).mean(axis=1)
+    row = lines[:, 5].astype(np.float64)  # 40 % down the tail
+    assert np.ptp(np.percentile(row[:, 0], [5, 95])) > 0.054
+    assert np.ptp(np.percentile(row[:, 1], [5, 95])) > 0.04
+
+
+def test_bob_ends_turn_in_and_vary_in_length(body):
+    """The bob's ends curl in towards the neck over their last few centimetres and end at
+    layered lengths (they hung straight to one level: a box edge)."""
+    centre, _ = hair.head_frame(body)
+    lines = hair.hang_cards(body, hair.flow_parted()).mesh.vertices.reshape(-1, 2, 11, 3)
+    lines = lines.mean(axis=1).astype(np.float64)
+    back = lines[:, -1, 1] > centre[1] - 0.02
+
+    def from_axis(p):
+        return np.hypot(p[..., 0] - centre[0], p[..., 1] - centre[1])
+
+    assert np.median(from_axis(lines[back, -1]) - from_axis(lines[back, -3])) < -0.006
+    assert lines[back, -1, 2].std() > 0.006  # was 2.3 mm

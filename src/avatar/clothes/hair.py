@@ -21,6 +21,7 @@ from avatar.clothes.authoring import (
     Piece,
     bound,
     cut,
+    join,
     orient_outward,
 )
 from avatar.geometry.shell import boundary_edges
@@ -83,9 +84,11 @@ def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) 
 
 # A short haircut's hairline, by the direction around the head (degrees from the front):
 # height above eye level. Rounded temple corners, sideburns in front of the ears, a line
-# curving over each ear and down to the nape.
+# curving over each ear and down to the nape. The line falls steadily from the forehead to
+# the temple: a corner raised at 45 degrees (a receding temple) showed as a notch where
+# hair is drawn back (a ponytail, a bun).
 HAIRLINE_DEG = (0, 30, 45, 60, 72, 76, 84, 88, 112, 120, 140, 180)
-HAIRLINE_M = (0.07, 0.068, 0.072, 0.05, 0.03, -0.012, -0.012, 0.035, 0.035, -0.02, -0.055, -0.065)
+HAIRLINE_M = (0.07, 0.067, 0.062, 0.048, 0.03, -0.012, -0.012, 0.035, 0.035, -0.02, -0.055, -0.065)
 
 
 def head_frame(body: AuthoringBody) -> tuple[np.ndarray, float]:
@@ -125,8 +128,15 @@ def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:
     return bound(body, cap_uvs(mesh, centre), faces)
 
 
-def flow_crown(crown_offset=(0.0, 0.035, 0.1), sweep: float = 0.6):
-    """A hair flow field radiating from the crown, the front swept towards +x."""
+CROWN_OFFSET = (0.0, 0.035, 0.1)  # the crown (whorl) from the skull centre at eye height (m)
+
+
+def flow_crown(crown_offset=CROWN_OFFSET, sweep: float = 0.6, whorl: float = 1.2):
+    """A hair flow field combed out from the crown, the front swept towards +x, turning
+    round the crown in a whorl (a spiral, as hair grows there): near the crown the
+    hair runs round it as much as away from it (``whorl`` times as much), fading to
+    straight out over 5-8 cm. (Straight out from one point everywhere, the cards seen
+    from above all pointed away from the crown like a sea urchin's spines.)"""
 
     def flow(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
         crown = centre + np.asarray(crown_offset)
@@ -134,6 +144,8 @@ def flow_crown(crown_offset=(0.0, 0.035, 0.1), sweep: float = 0.6):
         front = np.clip((centre[1] - points[:, 1]) / 0.08, 0, 1) * np.clip(
             (points[:, 2] - eye_z - 0.04) / 0.04, 0, 1
         )
+        round_ = whorl * np.exp(-((np.hypot(d[:, 0], d[:, 1]) / 0.05) ** 2))
+        d[:, :2] += round_[:, None] * np.stack([-d[:, 1], d[:, 0]], 1)
         d[:, 0] += sweep * front * np.linalg.norm(d, axis=1)
         return d
 
@@ -191,6 +203,9 @@ def grow_cards(
     roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
     depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
+    # Hair lies flat at the crown, where it parts round the whorl.
+    crown = centre + np.asarray(CROWN_OFFSET)
+    top *= 0.5 + 0.5 * np.clip(np.linalg.norm(roots - crown, axis=1) / 0.07, 0, 1)
     top *= rng.uniform(0.55, 1.0, count)
     # Short at the hairline (a fringe would hang over the face), full length further in.
     size = rng.uniform(length[0], length[1], count) * (0.45 + 0.55 * np.clip(depth / 0.04, 0, 1))
@@ -198,12 +213,72 @@ def grow_cards(
     point = roots
     for k in range(1, segments + 1):
         step = _tangent(body, point, flow(point, centre, eye_z))
+        # Rising evenly along the card (lying down from the root), not steeply at first:
+        # a card whose first half rose at 15-25 degrees stood up from the scalp.
         point = _above_skin(body, point + step * (size / segments)[:, None],
-                            0.002 + (top - 0.002) * (k / segments) ** 0.7)  # fmt: skip
+                            0.002 + (top - 0.002) * (k / segments))  # fmt: skip
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
-    return _card_piece(body, path, normal, width, rng)
+    fringe = _over_the_face(path, centre, eye_z) & (width > 2.5 * FRINGE_STRAND_M)
+    if not fringe.any():
+        return _card_piece(body, path, normal, width, rng)
+    strands, facing = _strands(path[fringe], normal[fringe], width, rng)
+    count = len(strands)
+    return join([
+        _card_piece(body, path[~fringe], normal[~fringe], width, rng),
+        _card_piece(body, strands, facing, np.full(count, FRINGE_STRAND_M), rng,
+                    taper=rng.uniform(0.2, 0.45, count)),
+    ])  # fmt: skip
+
+
+# Hair falling over the forehead (a fringe, bangs) as strands this wide (m): a card 2.5 cm
+# wide hanging over the face reads as a strip of paper, its straight edges and cut tip
+# against the skin; strands a few millimetres wide, each ending at its own length and
+# tapering to a point, read as hair.
+FRINGE_STRAND_M = 0.0045
+
+
+def _over_the_face(path: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+    """(N,) bool cards (paths (N, K, 3)) whose tips hang over the forehead: in front of
+    the face and below the front hairline's height (``HAIRLINE_M`` at 0 degrees)."""
+    tip = path[:, -1]
+    return (tip[:, 1] < centre[1] - 0.06) & (tip[:, 2] < eye_z + HAIRLINE_M[0] + 0.01)
+
+
+def _strands(path: np.ndarray, normal: np.ndarray, width: float, rng
+             ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Wide cards (paths (N, K, 3) facing ``normal``) split lengthwise into strands
+    ``FRINGE_STRAND_M`` wide side by side across each card's width, each parting a little
+    from its neighbours towards its tip, ending at its own length (55-100 % of the card)
+    and turned a little about its path. Returns (paths (M, K, 3), normals (M, K, 3))."""
+    n, k = path.shape[:2]
+    per = max(int(round(width / FRINGE_STRAND_M * 1.3)), 2)  # overlapping: no gaps between
+    side = np.cross(normal, np.gradient(path, axis=1))
+    side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
+    t = np.linspace(0, 1, k)[None, :, None]
+    offset = (np.linspace(-0.5, 0.5, per)[None, :] + rng.normal(0, 0.08, (n, per))) * width
+    spread = 1 + rng.uniform(0.0, 0.5, (n, per)) * 1.0  # tips part from their neighbours
+    shift = offset[..., None, None] * (1 + (spread[..., None, None] - 1) * t[:, None] ** 2)
+    strands = path[:, None] + shift * side[:, None]  # (N, per, K, 3)
+    strands = strands.reshape(-1, k, 3)
+    facing = np.repeat(normal, per, axis=0)
+    m = len(strands)
+    strands = _shorten(strands, rng.uniform(0.55, 1.0, m))
+    turn = rng.uniform(-0.5, 0.5, m)[:, None, None]
+    side = np.repeat(side, per, axis=0)
+    return strands, np.cos(turn) * facing + np.sin(turn) * side
+
+
+def _shorten(path: np.ndarray, fraction: np.ndarray) -> np.ndarray:
+    """(N, K, 3) paths resampled evenly (by sample index) over their first ``fraction``
+    (N,) of their samples."""
+    count, k = path.shape[:2]
+    at = np.linspace(0, 1, k)[None, :] * fraction[:, None] * (k - 1)
+    lo = np.minimum(np.floor(at).astype(int), k - 2)
+    frac = (at - lo)[..., None]
+    n = np.arange(count)[:, None]
+    return (1 - frac) * path[n, lo] + frac * path[n, lo + 1]
 
 
 def cards_on(
@@ -280,7 +355,8 @@ def guides(body: AuthoringBody, samples: int = 16, behind: bool = True) -> np.nd
     (which its targets reshape with every body): each ribbon's centre line from the crown
     to the tip, resampled evenly by length. The short fringe ribbons over the face are left
     out, and with ``behind`` those falling in front of the shoulders; the curves are ordered
-    by their direction around the head."""
+    by their direction around the head, from the right side round the back to the left
+    (neighbours in the order are neighbours on the head)."""
     from avatar.clothes.face import strip_uvs
 
     faces = body.group_faces("helper-hair")
@@ -299,7 +375,10 @@ def guides(body: AuthoringBody, samples: int = 16, behind: bool = True) -> np.nd
         line = np.stack([points[row == r].mean(0) for r in range(row.max() + 1)])
         curves.append(_resample(line, samples))
     out = np.stack(curves)
-    return out[np.argsort(np.arctan2(out[:, -1, 0], -(out[:, -1, 1] - centre[1])))]
+    # Ordered from one side round the back to the other: measured from the front, the
+    # angle jumps from +180 to -180 degrees at the back's midline, which put the two
+    # curves either side of it at the two ends of the order, never blended (a seam).
+    return out[np.argsort(np.arctan2(out[:, -1, 0], out[:, -1, 1] - centre[1]))]
 
 
 def _components(faces: np.ndarray) -> list[np.ndarray]:
@@ -351,11 +430,7 @@ def long_cards(
     path = (1 - w) * g[first[pick]] + w * g[second[pick]]  # (N, K, 3)
     k = path.shape[1]
     # Shorter cards end higher up: sample each path to a random fraction of its length.
-    at = np.linspace(0, 1, k)[None, :] * rng.uniform(0.75, 1.0, count)[:, None] * (k - 1)
-    lo = np.minimum(np.floor(at).astype(int), k - 2)
-    frac = (at - lo)[..., None]
-    n = np.arange(count)[:, None]
-    path = (1 - frac) * path[n, lo] + frac * path[n, lo + 1]
+    path = _shorten(path, rng.uniform(0.75, 1.0, count))
     t = np.linspace(0, 1, k)[None, :, None]
     height = rng.uniform(layers[0], layers[1], count)[:, None, None] * np.sqrt(t)
     flat = path.reshape(-1, 3)
@@ -371,17 +446,20 @@ def long_cards(
 
 
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
-                surface: np.ndarray | None = None, taper: float = 0.7,
+                surface: np.ndarray | None = None, taper=0.7,
                 tip_v: float = 0.0) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
-    (or to ``surface``, (S, 4) base-mesh faces of it), narrowing to ``taper`` of their
-    width at the tips, their texture running from the roots (v = 0.5) to ``tip_v`` (0:
-    the texture's thinned-out strand tips; more: cut ends, as a blunt haircut has)."""
+    (or to ``surface``, (S, 4) base-mesh faces of it), ``width`` m wide (a float or one per
+    card, (N,)), narrowing to ``taper`` (a float or (N,)) of their width at the tips,
+    their texture running from the roots (v = 0.5) to ``tip_v`` (0: the texture's
+    thinned-out strand tips; more: cut ends, as a blunt haircut has)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
+    width = np.broadcast_to(np.asarray(width, np.float64), (count,))[:, None, None]
+    taper = np.broadcast_to(np.asarray(taper, np.float64), (count,))[:, None, None]
     half = (width / 2) * rng.uniform(0.7, 1.2, count)[:, None, None]
-    half = half * np.linspace(1, taper, k)[None, :, None]
+    half = half * (1 + (taper - 1) * np.linspace(0, 1, k)[None, :, None])
     verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2K, 3)
     j = np.arange(k - 1)
     quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
@@ -395,11 +473,11 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     return bound(body, mesh, body.skin_faces if surface is None else surface)
 
 
-def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 150, seed: int = 2) -> Piece:
+def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 210, seed: int = 2) -> Piece:
     """A tied-back tail: strand cards around a spine hanging from the back of the head,
     gathered tight at the tie, fuller below it and tapering to the tips.
 
-    A bundle, not a ribbon: many narrow cards (1.3 cm) fill the tail's whole section
+    A bundle, not a ribbon: many narrow cards (1.6 cm) fill the tail's whole section
     (each at its own depth, from the core to the surface) and each is turned by its own
     angle about the spine, so from any side some are seen face on and some edge on; their
     paths wander and their tips splay apart. (60 cards 2 cm wide on the tail's surface,
@@ -412,21 +490,25 @@ def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 150, seed: i
     t = np.linspace(0, 1, k)
     # The tail falls back and down, then down along the upper back.
     spine = root + np.stack([0 * t, 0.05 * np.sin(t * np.pi / 2) + 0.03 * t, -length * t], 1)
-    radius = 0.008 + 0.022 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.5 * t)
+    # Gathered at the tie (1.2 cm), full below it (~7 cm across), tapering to the tips.
+    radius = 0.012 + 0.03 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.55 * t)
     angle = rng.uniform(0, 2 * np.pi, count)[:, None] + rng.normal(0, 0.3, count)[:, None] * t
     reach = np.sqrt(rng.uniform(0.1, 1.0, count))[:, None] * 1.05  # filled, not a shell
     splay = 1 + 0.35 * t[None, :] ** 3 * rng.uniform(0, 1, count)[:, None]  # tips part
-    radial = np.stack([np.cos(angle), np.sin(angle) * 0.7, np.zeros_like(angle)], -1)
+    radial = np.stack([np.cos(angle), np.sin(angle) * 0.8, np.zeros_like(angle)], -1)
     path = spine[None] * np.array([1, 1, 0]) + radial * (radius * reach * splay)[..., None]
     wander = rng.normal(0, 0.004, (count, 1, 3)) * np.sin(np.pi * t)[None, :, None]
     path = path + wander * np.array([1, 1, 0])
     path[..., 2] = root[2] - length * t[None, :] * rng.uniform(0.8, 1.05, count)[:, None]
     # Each card turned about the spine by its own angle (the cards' faces point along
     # ``radial`` turned towards the tangent round the tail).
-    turn = rng.uniform(-1.0, 1.0, count)[:, None, None]
+    # (Turned up to 35 degrees, the outer cards mostly face out and catch the light: a
+    # tail of cards turned every way up to 57 degrees was seen edge on into its shaded
+    # core, darker and narrower than the hair on the head.)
+    turn = rng.uniform(-0.6, 0.6, count)[:, None, None]
     around = np.stack([-radial[..., 1], radial[..., 0], np.zeros_like(angle)], -1)
     facing = np.cos(turn) * radial + np.sin(turn) * around
-    return _card_piece(body, path, facing, 0.013, rng)
+    return _card_piece(body, path, facing, 0.016, rng)
 
 
 def brim(body: AuthoringBody, cap: Piece, reach: float = 0.07) -> Piece:
@@ -512,11 +594,30 @@ def hang_cards(
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
-    path = _cut_at(path, stop)
+    # Layered: a third of the cards end up to 2.5 cm above the line (the cut's outer
+    # layers), so the ends vary in length instead of one box edge.
+    layer = ~front & (rng.uniform(size=count) < 0.35)
+    stop[layer] += rng.uniform(0.008, 0.025, layer.sum())
+    path = _curl_in(body, _cut_at(path, stop), centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
-    # A blunt cut: full-width cards to the end, their strands cut there rather than
-    # thinning out (tapered, thinned tips a centimetre apart read as frayed ends).
-    return _card_piece(body, path, normal, width, rng, taper=0.95, tip_v=0.25)
+    # A blunt cut: cards to the end, their strands cut there rather than thinning out
+    # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
+    # as the ends turn in.
+    return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
+
+
+def _curl_in(body: AuthoringBody, path: np.ndarray, centre: np.ndarray,
+             reach: float = 0.035, depth: float = 0.012) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) hanging paths whose last ``reach`` m turn in towards the head's vertical
+    axis by up to ``depth`` m at the tips (a bob's ends curl under; hanging straight down
+    they ended in a box edge), kept 2 mm off the skin."""
+    seg = np.linalg.norm(np.diff(path, axis=1), axis=2)
+    arc = np.concatenate([np.zeros((len(path), 1)), np.cumsum(seg, axis=1)], 1)
+    s = np.clip((arc - (arc[:, -1:] - reach)) / reach, 0, 1)  # 0 above, 1 at the tip
+    inward = (centre - path) * np.array([1.0, 1.0, 0.0])
+    inward /= np.maximum(np.linalg.norm(inward, axis=-1, keepdims=True), 1e-9)
+    curled = path + (depth * s**2)[..., None] * inward
+    return _off_skin(body, curled.reshape(-1, 3), 0.002).reshape(path.shape)
 
 
 def _off_skin(body: AuthoringBody, points: np.ndarray, gap) -> np.ndarray:
