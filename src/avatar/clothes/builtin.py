@@ -205,20 +205,52 @@ def sleeve_ease(base: float, extra: float):
     return lambda p, arm, leg: base + extra * np.clip(arm, 0, 1)
 
 
-def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str,
-              cap_colour: str | None = None):  # fmt: skip
-    """A shoe's atlas material (``shoes.ROWS``): upper, toe cap, sole and laces."""
+def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str | None = None,
+              cap_colour: str | None = None, sole: str = "rubber"):  # fmt: skip
+    """A shoe's atlas material (``shoes.ROWS``): upper, toe cap, sole and laces; laces
+    ``lace_contrast`` to the upper unless ``lace_colour`` names one."""
 
     def look(spec: Spec, size: int) -> Material:
         rows = shoes.ROWS
+        laces = lace_contrast(upper_colour) if lace_colour is None else lace_colour
         return fabrics.atlas(spec.name, [
             (*rows["upper"], upper, upper_colour),
             (*rows["cap"], upper, cap_colour or upper_colour),
-            (*rows["sole"], "rubber", sole_colour),
-            (*rows["laces"], "cord", lace_colour),
+            (*rows["sole"], sole, sole_colour),
+            (*rows["laces"], "cord", laces),
         ], size, stitches=(0.5 + 0.5 * 0.12, 0.3 + 0.2 * 0.2))  # fmt: skip
 
     return look
+
+
+LACE_CONTRAST = 18.0  # CIE L* between laces and the upper: black laces vanished on black
+
+
+def lace_contrast(upper_colour) -> tuple[float, float, float]:
+    """Linear RGB of laces that read against an upper of ``upper_colour``: its own hue,
+    LACE_CONTRAST units of CIE lightness lighter on a dark upper (grey on black, mid brown
+    on dark brown), darker on a light one (dark brown on brown, light grey on white
+    canvas), never white."""
+    colour = fabrics.rgb(upper_colour)
+    luminance = max(float(colour @ [0.2126, 0.7152, 0.0722]), 1e-4)
+    lightness = _cie_lightness(luminance)
+    wanted = lightness + LACE_CONTRAST if lightness < 30 else lightness - LACE_CONTRAST
+    # Scaling keeps the hue; a near-black upper (no hue to keep) is mixed towards grey.
+    target = _cie_luminance(wanted)
+    grey = max(0.0, 1 - 30 * luminance)
+    mixed = (1 - grey) * colour * (target / luminance) + grey * np.full(3, target)
+    r, g, b = (float(c) for c in np.clip(mixed, 0, 1))
+    return r, g, b
+
+
+def _cie_lightness(luminance: float) -> float:
+    y = luminance
+    return 116 * y ** (1 / 3) - 16 if y > 216 / 24389 else y * 24389 / 27
+
+
+def _cie_luminance(lightness: float) -> float:
+    f = (lightness + 16) / 116
+    return f**3 if f**3 > 216 / 24389 else lightness * 27 / 24389
 
 
 # A dress's bodice: the tank top's cut on wider straps, its neckline scooped 9 cm below the
@@ -506,10 +538,10 @@ SPECS = [
     Spec("dress", "dresses", _dress, "cotton", "teal", DRESS_THICKNESS, 38, ("dress",), clearance=DRESS_CLEARANCE),  # noqa: E501
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001, snug=SNUG), "lycra", "sky", SNUG_THICKNESS, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
-    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "charcoal", "dark brown", "dark brown")),  # noqa: E501
-    Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "black", "black", "charcoal")),  # noqa: E501
-    Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", "white", "grey")),  # noqa: E501
-    Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "black", "tan", "dark brown")),  # noqa: E501
+    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "sole brown", sole="sole")),  # noqa: E501
+    Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "sole black", sole="sole")),  # noqa: E501
+    Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", cap_colour="light grey")),  # noqa: E501
+    Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "sole black", sole="sole")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.0, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501

@@ -29,6 +29,11 @@ MERIDIANS = 72  # around the crown (a multiple of GORES: seams fall on meridians
 RINGS = 16  # from the rim up to the button
 BRIM_REACH = 0.075  # m the brim stands out in front
 BRIM_THICK = 0.004
+# The brim's top meets the crown's band (the band's lower edge BRIM_SEAT m into it) and
+# its plate runs BRIM_TUCK m on under the crown, as a brim is sewn inside the sweatband:
+# attached 2 mm below the rim, under a band standing 1.5 mm proud, it left a slit that
+# rendered as a dark line between band and brim.
+BRIM_SEAT, BRIM_TUCK = 0.0015, 0.0035
 BRIM_SPAN = 68.0  # degrees either side of the front the brim is attached over (temple to temple)
 UV_PER_METRE = 2.0  # the cap's texture: roughly 0.5 m of cloth across it
 
@@ -162,7 +167,11 @@ def brim(body: AuthoringBody, crown_mesh: Mesh, rim: np.ndarray) -> Mesh:
     phi = np.arctan2(rel[:, 0], -rel[:, 1])
     order = np.argsort(phi)
     front = order[np.abs(phi[order]) < np.radians(BRIM_SPAN)]
-    inner = v[rim][front] + [0, 0, -0.002]
+    inner = v[rim][front] + [0, 0, BRIM_SEAT]
+    inward = centre[:2] - inner[:, :2]
+    inward /= np.linalg.norm(inward, axis=1, keepdims=True)
+    tuck = inner.copy()
+    tuck[:, :2] += BRIM_TUCK * inward
     x_half = float(np.abs(inner[:, 0]).max())
     # The outline in plan: BRIM_REACH ahead of the rim's middle, rounding back to the
     # rim at the ends (a squarish D); each rim point reaches straight forward to it.
@@ -171,8 +180,8 @@ def brim(body: AuthoringBody, crown_mesh: Mesh, rim: np.ndarray) -> Mesh:
     outline = nose - BRIM_REACH * np.clip(1 - (inner[:, 0] / x_half) ** 2, 0, 1) ** 0.35
     reach = np.clip(inner[:, 1] - outline, 0, None)
     steps = np.linspace(0, 1, 8)
-    rows = []
-    for t in steps:  # from the crown out to the edge
+    rows = [tuck]  # under the crown, then from the crown's rim out to the edge
+    for t in steps:
         pt = inner + (reach * t)[:, None] * forward
         # Curved down at the sides (pre-bent), tipped a little down at the front.
         pt[:, 2] -= 0.018 * (pt[:, 0] / x_half) ** 2 * t + 0.01 * t**1.5
@@ -216,7 +225,7 @@ def brim(body: AuthoringBody, crown_mesh: Mesh, rim: np.ndarray) -> Mesh:
     u = (points[:, 0] + x_half) / (2 * x_half)
     r_of = np.concatenate([np.repeat(np.arange(grid.shape[0]), n), [0, 0]])
     tops = len(top_rows)
-    out_frac = np.where(r_of < tops, r_of / (tops - 1), 1.0)
+    out_frac = np.where(r_of < tops, np.clip(r_of - 1, 0, None) / (tops - 2), 1.0)
     uv_v = 0.02 + 0.24 * out_frac
     uv = np.stack([0.05 + 0.9 * u, uv_v], -1)[f.ravel()].astype(np.float32)
     corners = np.arange(f.size, dtype=np.int32).reshape(f.shape)

@@ -4,11 +4,12 @@ and laces, all generated on the authoring body and bound to it, so they fit ever
 Parts, per foot (``x > 0`` is the body's left):
 
 - upper: the ``helper-tights`` faces of the foot and ankle, eased off the skin, its
-  opening and bottom edge smoothed into curves;
-- sole: a ring extruded from the upper's bottom edge, out by a welt, down to a flat tread a
-  little below the foot, lifted under the arch so heel block and forefoot read apart, and
-  closed underneath;
-- toe cap: the front of the upper again, a millimetre and a half further out;
+  opening smoothed into a curve, the toe box drawn out past the toes and sloping down to
+  its tip, the bottom edge drawn down to just above the ground;
+- sole: a thin edge (``_sole_edge``) round the upper's bottom edge, out by a welt, down to
+  a tread a little below the foot, taller at the heel (a heel block), lifted under the
+  arch and curling up at the toe (toe spring), closed underneath;
+- toe cap: the front of the upper again, sewn flat on it (under a millimetre out);
 - laces: bars across the instep, lying on the upper.
 
 The four share one material: an atlas (``looks.atlas``) whose rows hold leather, toe-cap
@@ -23,11 +24,25 @@ from avatar.clothes import regions
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join
 from avatar.mesh import Mesh
 
-EASE = 0.005  # m between foot and upper
-SOLE = 0.008  # m of tread under the lowest point of the upper
-WELT = 0.004  # m the sole stands out of the upper
+EASE = 0.005  # m between foot and upper (less let toes and socks through mid-stride)
+# The sole's edge, as a render shows it: UNDER m of tread below the foot's lowest point,
+# rising COVER m over the upper's bottom edge (which it hides), to at least HEEL m above
+# the foot's ground at the heel (a heel block), and a welt WELT m out of the upper. It
+# was 8 mm of tread under the foot's lowest point plus the upper's ragged edge 2.5-15 mm
+# up it: a 2-3 cm slab all round, a clog's.
+UNDER = 0.006
+COVER = 0.002
+HEEL = 0.014
+WELT = 0.003
 ARCH = 0.006  # m the tread is lifted between heel block and ball of the foot
-CAP_EASE = EASE + 0.0015
+SPRING = 0.012  # m the tread curls up at the tip of the toe box (toe spring)
+CAP_EASE = EASE + 0.0007  # a toe cap sewn flat on the vamp, not a shell over it
+# The upper's faces end OPEN_BOTTOM m above the foot's lowest point, then its bottom
+# edge is drawn down to EDGE m above it (the sole covers it): left where the faces ended
+# it wandered 2.5-15 mm above the ground, and the sole's edge with it (a clog's slab);
+# cutting the faces lower let the toes' bumps through the leather.
+OPEN_BOTTOM = 0.012
+EDGE = 0.002
 LACES = 5  # bars across the instep
 
 # Atlas rows (v0, v1) in the shoe material: leather upper, toe cap, sole rubber, laces.
@@ -68,7 +83,7 @@ def _shoe_faces(body: AuthoringBody, foot: Foot, faces: np.ndarray,
     ff = regions.face_features(body.vertices, faces, body.part, body.marks)
     side = np.sign(ff.centre[:, 0]) == (1 if foot.side == 0 else -1)
     shoe = (ff.part == "foot") | ((ff.part == "leg") & (ff.leg > top))
-    low = ff.centre[:, 2] < foot.ground + 0.012
+    low = ff.centre[:, 2] < foot.ground + OPEN_BOTTOM
     if top > LOW:
         line = np.interp(foot.along(ff.centre), *TOPLINE)
         shoe &= ff.centre[:, 2] < foot.ground + line
@@ -79,8 +94,21 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     """The upper up to ``top`` along the leg (0.96: below the ankle; 0.85: an ankle boot)."""
     faces = body.group_faces("helper-tights")
     mesh = cut(body, faces, _shoe_faces(body, foot, faces, top), EASE, relax=10)
-    mesh = _toe_box(body, foot, mesh, EASE)
+    mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, EASE))
     return bound(body, _planar_uvs(mesh, "upper"), faces)
+
+
+def _drawn_down(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float = EASE) -> Mesh:
+    """The upper (or toe cap) with its bottom edge drawn straight down to EDGE m above the
+    ground, the tip curling up with the sole's toe spring (the sole can only curl as far
+    as the edge it covers), still ``ease`` off the skin."""
+    v = mesh.vertices.astype(np.float64)
+    loop = _lowest_loop(mesh)
+    loop = loop[v[loop, 2] < foot.ground + OPEN_BOTTOM + 0.01]  # a toe cap's back edge stays
+    spring = SPRING * np.clip((foot.along(v[loop]) - 0.84) / 0.2, 0, 1) ** 2
+    v[loop, 2] = np.minimum(v[loop, 2], foot.ground + EDGE + spring)
+    v[loop] = _at_least(body, v[loop], ease)
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
@@ -88,7 +116,7 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     centre = body.vertices[faces].mean(axis=1)
     keep = _shoe_faces(body, foot, faces) & (foot.along(centre) > 0.78)
     mesh = cut(body, faces, keep, CAP_EASE, relax=8)
-    mesh = _toe_box(body, foot, mesh, CAP_EASE)
+    mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, CAP_EASE), CAP_EASE)
     return bound(body, _planar_uvs(mesh, "cap"), faces)
 
 
@@ -113,7 +141,13 @@ def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float) -> Mesh:
         np.add.at(total, b, v[a])
         average = total / np.maximum(degree, 1)[:, None]
         v = np.where(rim[:, None], v, v + 0.6 * (0.3 + 0.7 * weight) * (average - v))
-    v[:, 1] -= 0.013 * np.clip((t - 0.6) / 0.4, 0, 1) ** 2  # the toe box reaches past the toes
+    front = np.clip((t - 0.6) / 0.4, 0, 1) ** 2
+    v[:, 1] -= 0.016 * front  # the toe box reaches past the toes
+    # ... and slopes down to its tip (a last's toe, not a clog's blunt dome): in front of
+    # the toes the height over the sole taken down by up to 40% (over the toes their
+    # clearance would push the bumps of the toes back into the leather).
+    tip = np.clip((t - 0.8) / 0.25, 0, 1) ** 2
+    v[:, 2] -= 0.4 * tip * np.clip(v[:, 2] - foot.ground - 0.008, 0, None)
     v = _at_least(body, v, ease)
     # Fill the hollows between toes: smoothing that only ever moves a vertex outwards.
     normal = body.outward(v)
@@ -155,18 +189,17 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     ring = ring.copy()
     ring[:, :2] += extra[:, None] * out
     t = foot.along(ring)
-    # The tread: flat under heel and ball, lifted under the arch (a heel block).
-    lift = ARCH * np.clip(1 - np.abs(t - 0.45) / 0.15, 0, 1) ** 0.5
-    tread = foot.ground - EASE - SOLE + 0.004
+    edge, tread = _sole_edge(ring, t, foot)
     rings = [
         np.column_stack([ring[:, :2] - 0.001 * out - extra[:, None] * out,
-                         ring[:, 2] + 0.006]),  # tucked under the upper's edge
-        np.column_stack([ring[:, :2] + WELT * out, ring[:, 2] + 0.004]),  # welt top
-        np.column_stack([ring[:, :2] + WELT * out, np.full(len(ring), tread + 0.004) + lift]),
-        np.column_stack([ring[:, :2] + (WELT - 0.002) * out, np.full(len(ring), tread) + lift]),
+                         edge + 0.001]),  # tucked under the upper's edge
+        np.column_stack([ring[:, :2] + WELT * out, edge]),  # welt top
+        np.column_stack([ring[:, :2] + WELT * out, tread + 0.002]),
+        np.column_stack([ring[:, :2] + (WELT - 0.0015) * out, tread]),  # the edge rounded
     ]
     n = len(ring)
-    points = np.concatenate([*rings, [[centre[0], centre[1], tread]]])
+    # The tread's middle, under the arch: lifted as the arch's edge is, by half.
+    points = np.concatenate([*rings, [[centre[0], centre[1], tread.min() + ARCH / 2]]])
     faces = []
     for r in range(len(rings) - 1):
         a, b = r * n, (r + 1) * n
@@ -178,6 +211,23 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     mesh = Mesh(points.astype(np.float32), np.array(faces, np.int32))
     mesh = _facing_out(mesh, centre + [0, 0, 0.02])
     return bound(body, _planar_uvs(mesh, "sole"), body.group_faces("helper-tights"))
+
+
+def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot) -> tuple[np.ndarray, np.ndarray]:
+    """(top (n,), tread (n,)) z of the sole's edge round the ``ring`` (n, 3) of the upper's
+    bottom edge at ``t`` (n,) along the foot: the top COVER over the upper's edge (smoothed
+    round the ring, at least HEEL above the ground behind the heel's breast); the tread
+    flat under heel and ball, lifted ARCH under the arch and SPRING at the toe's tip."""
+    top = ring[:, 2] + COVER
+    for _ in range(6):  # the upper's edge follows whole helper faces: a ragged line
+        smooth = 0.5 * top + 0.25 * (np.roll(top, 1) + np.roll(top, -1))
+        top = np.maximum(ring[:, 2] + COVER, smooth)
+    heel = np.clip((0.3 - t) / 0.06, 0, 1)  # the heel block ends at its breast, t ~ 0.27
+    top = np.maximum(top, foot.ground + HEEL * heel)
+    arch = ARCH * np.clip(1 - np.abs(t - 0.45) / 0.15, 0, 1) ** 0.5
+    spring = SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
+    tread = foot.ground - UNDER + arch + spring
+    return top, np.minimum(tread, top - 0.004)
 
 
 def laces(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:

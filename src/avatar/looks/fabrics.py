@@ -56,6 +56,9 @@ FABRICS = {
     "hair": Fabric("hair", "strands", 220, 2.5, 0.5, 0.6),
     "rubber": Fabric("rubber", "grain", 90, 0.8, 0.75, 0.05),
     "calf": Fabric("calf", "grain", 220, 0.25, 0.35, 0.04),  # smooth shoe leather
+    # A leather sole's edge, inked and burnished: smooth, semi-matt (rubber's grain and
+    # roughness read as grey plastic on a dress shoe).
+    "sole": Fabric("sole", "grain", 160, 0.2, 0.5, 0.03, rough_weave=0.05),
     "cord": Fabric("cord", "twill", 40, 2.5, 0.9, 0.3),
     "linen": Fabric("linen", "plain", 110, 1.6, 0.9, 0.22),  # coarse, slubby plain weave
 }
@@ -74,6 +77,7 @@ COLOURS = {
     "auburn hair": (0.14, 0.045, 0.018), "grey hair": (0.36, 0.35, 0.34),
     "dark brown": (0.07, 0.035, 0.018), "light indigo": (0.16, 0.25, 0.45),
     "dark indigo": (0.007, 0.011, 0.04), "light grey": (0.6, 0.61, 0.62),
+    "sole brown": (0.03, 0.016, 0.009), "sole black": (0.012, 0.011, 0.011),
 }  # fmt: skip
 
 
