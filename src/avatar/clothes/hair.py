@@ -224,6 +224,9 @@ def grow_cards(
     if not fringe.any():
         return _card_piece(body, path, normal, width, rng)
     strands, facing = _strands(path[fringe], normal[fringe], width, rng)
+    # Spread sideways across the card's plane, strands at its edges would cut into the
+    # temples where the head curves in under them.
+    strands = _off_skin(body, strands.reshape(-1, 3), 0.003).reshape(strands.shape)
     count = len(strands)
     return join([
         _card_piece(body, path[~fringe], normal[~fringe], width, rng),
@@ -241,9 +244,12 @@ FRINGE_STRAND_M = 0.0045
 
 def _over_the_face(path: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
     """(N,) bool cards (paths (N, K, 3)) whose tips hang over the forehead: in front of
-    the face and below the front hairline's height (``HAIRLINE_M`` at 0 degrees)."""
+    the face, between the temples and below the front hairline's height (``HAIRLINE_M``
+    at 0 degrees). (Those at the temples, split and fanned out, reached into a fuller
+    cheek than the authoring body's.)"""
     tip = path[:, -1]
-    return (tip[:, 1] < centre[1] - 0.06) & (tip[:, 2] < eye_z + HAIRLINE_M[0] + 0.01)
+    return ((tip[:, 1] < centre[1] - 0.06) & (np.abs(tip[:, 0]) < 0.06)
+            & (tip[:, 2] < eye_z + HAIRLINE_M[0] + 0.01))  # fmt: skip
 
 
 def _strands(path: np.ndarray, normal: np.ndarray, width: float, rng
@@ -473,7 +479,7 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     return bound(body, mesh, body.skin_faces if surface is None else surface)
 
 
-def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 210, seed: int = 2) -> Piece:
+def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 240, seed: int = 2) -> Piece:
     """A tied-back tail: strand cards around a spine hanging from the back of the head,
     gathered tight at the tie, fuller below it and tapering to the tips.
 
@@ -490,8 +496,8 @@ def ponytail(body: AuthoringBody, length: float = 0.3, count: int = 210, seed: i
     t = np.linspace(0, 1, k)
     # The tail falls back and down, then down along the upper back.
     spine = root + np.stack([0 * t, 0.05 * np.sin(t * np.pi / 2) + 0.03 * t, -length * t], 1)
-    # Gathered at the tie (1.2 cm), full below it (~7 cm across), tapering to the tips.
-    radius = 0.012 + 0.03 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.55 * t)
+    # Gathered at the tie (2.5 cm across), full below it (7-8 cm), tapering to the tips.
+    radius = 0.0125 + 0.037 * np.sin(np.pi * np.clip(t / 0.7, 0, 1) * 0.8) * (1 - 0.55 * t)
     angle = rng.uniform(0, 2 * np.pi, count)[:, None] + rng.normal(0, 0.3, count)[:, None] * t
     reach = np.sqrt(rng.uniform(0.1, 1.0, count))[:, None] * 1.05  # filled, not a shell
     splay = 1 + 0.35 * t[None, :] ** 3 * rng.uniform(0, 1, count)[:, None]  # tips part
