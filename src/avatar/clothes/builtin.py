@@ -75,18 +75,19 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
 
 def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
           hug: float | None = None, under: np.ndarray | None = None,
-          gap: float = 0.004) -> Piece:  # fmt: skip
+          gap: float = 0.004, edge_gap: float = 0.0025) -> Piece:  # fmt: skip
     """A skirt from ``helper-skirt`` down to ``bottom_z``, swinging as one (``blend_sides``);
     ``tailor``: its own panel texture with side seams, a waistband (geometry too), a
     centre-back zip and a stitched hem band. ``hug``: m off the skin the skirt keeps down
     to the hip joints, flaring only below them (``tailoring.sit_on_hips``), outside the
-    points ``under`` (M, 3) of what it is worn over."""
+    points ``under`` (M, 3) of what it is worn over (``gap`` m out, ``edge_gap`` at its
+    top edge)."""
     faces = body.group_faces("helper-skirt")
     centre_z = body.vertices[faces].mean(axis=1)[:, 2]
     mesh = cut(body, faces, centre_z > bottom_z, ease, RELAX, loose=True)
     if hug is not None:
         points = tailoring.sit_on_hips(body, mesh.vertices, hug, float(body.marks.hip[:, 2].mean()),
-                                       under=under, gap=gap)  # fmt: skip
+                                       under=under, gap=gap, edge_gap=edge_gap)  # fmt: skip
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
     if not tailor:
         return tailoring.blend_sides(body, bound(body, mesh, faces), "helper-skirt")
@@ -262,6 +263,14 @@ DRESS_HUG = 0.009  # m the dress's skirt keeps off the skin at the waist and hip
 # 5 mm clear and through both 1.5 mm layers (a speck of skin on the skirt). 6 mm clear and
 # 3 mm of cloth keep its outer surface outside the knee through the stride.
 DRESS_CLEARANCE, DRESS_THICKNESS = 0.006, 0.003
+# m the skirt keeps outside the bodice's (inner) points where it covers them: its cloth
+# and 2.5 mm. At 1 cm it stood 14-15 mm off the skin over the tucked hem against 9 mm
+# above and below, a ridge round the waist (a 3-12 mm ledge in renders).
+DRESS_OVER = DRESS_THICKNESS + 0.0025
+# ... closing to DRESS_SEAM m over the bodice's points at its top edge: inside the
+# bodice's cloth, so the bodice's surface runs on into the skirt's as across a sewn
+# waist seam (at 2.5 mm the skirt's edge stood 3-6 mm proud of the bodice, a ledge).
+DRESS_SEAM = 0.0015
 dress_bodice = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
 
 
@@ -278,8 +287,33 @@ def _dress(body: AuthoringBody) -> Piece:
     # The skirt's top lies over the bodice's hem (the bodice keeps 4 mm), sits on the hips
     # and flares below them.
     skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04),
-                         hug=DRESS_HUG, under=bodice.vertices, gap=0.01)
-    return join([bound(body, bodice, faces), skirt_piece])
+                         hug=DRESS_HUG, under=bodice.vertices, gap=DRESS_OVER,
+                         edge_gap=DRESS_SEAM)  # fmt: skip
+    waist = float(body.marks.hip[:, 2].mean()) + DRESS_WAIST
+    return join([bound(body, bodice, faces), _waist_bound(body, skirt_piece, faces, waist)])
+
+
+# m above the hip joints from which the dress's skirt follows the surface its bodice
+# follows (``_waist_bound``).
+DRESS_WAIST = 0.03
+
+
+def _waist_bound(body: AuthoringBody, piece: Piece, faces: np.ndarray, above: float) -> Piece:
+    """``piece`` with its vertices above ``above`` m re-bound to ``faces`` (the bodice's
+    surface): bound to the helper skirt, the skirt's top met its bodice on the authoring
+    body only, and stood 3-7 mm proud of it on a child or a slim woman (a ledge round the
+    waist). Below, the swinging skirt's binding is kept."""
+    from avatar.clothes.binder import bind
+    from avatar.clothes.binding import make_binding
+
+    b = piece.binding
+    tight = bind(piece.mesh.vertices, body.vertices, faces)
+    top = (piece.mesh.vertices[:, 2] > above)[:, None]
+    binding = make_binding(np.where(top, tight.indices, b.indices),
+                           np.where(top, tight.weights, b.weights),
+                           np.where(top, tight.offsets, b.offsets), b.scale_refs,
+                           b.scale_lengths, np.zeros(len(b), bool))  # fmt: skip
+    return Piece(piece.mesh, binding, piece.layout)
 
 
 def _tucked(body: AuthoringBody, mesh: Mesh, ease: float, reach: float) -> Mesh:

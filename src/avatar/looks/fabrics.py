@@ -17,6 +17,14 @@ import numpy as np
 from avatar.material import Material
 
 TILE_METRES = 0.2
+# The finest period (m) a knit's or plain weave's relief keeps at full strength. Cycles
+# samples textures without mipmaps, so a finer one aliases at render distance (a pixel
+# spans 1-1.5 mm of cloth on a full figure): 1-3 mm knit rows and 1 mm cotton threads
+# with 45-58 degrees of RMS normal tilt beat into moire (zig-zag bands on a cardigan,
+# shimmer on a T-shirt). Finer relief fades to FINE_FLOOR of its strength: still there
+# in a close-up, no longer loud enough to beat. Twills (denim, wool) keep theirs: their
+# diagonal is their look, and tailored garments coarsen threads to the texel density.
+FINEST, FINE_FLOOR = 0.0035, 0.08
 
 
 @dataclass(frozen=True)
@@ -45,7 +53,7 @@ FABRICS = {
                     weft_share=0.3, slub=0.18, relief=0.3, rough_weave=0.16),
     # A knit's loops are in its relief (normal map); its colour varies only faintly with
     # them, or the fine V-loops shimmer (moire) at a distance and their direction shows.
-    "knit": Fabric("knit", "knit", 36, 2.5, 0.9, 0.06),
+    "knit": Fabric("knit", "knit", 36, 1.8, 0.9, 0.06),
     "jersey": Fabric("jersey", "knit", 90, 1.2, 0.8, 0.1),
     # Garment leather: a soft satin-to-matte grain (roughness ~0.55-0.7, gently varied),
     # shallow, so it reads as leather rather than crinkled wet plastic with glittery specks.
@@ -127,16 +135,33 @@ def height_field(fabric: Fabric, size: int, seed: int = 0) -> np.ndarray:
         diagonal = np.sin(n * (u + v) / 2) ** 2
         h = 0.6 * diagonal + 0.4 * np.abs(np.sin(n * u)) + 0.4 * grain
     elif fabric.weave == "knit":
-        # Rows of V-shaped loops: |sin| ridges bent by a zig-zag across each column.
+        # Rows of V-shaped loops: ridges bent by a zig-zag across each column, as many
+        # rows as columns per tile (a stitch about as tall as wide; rows twice as dense
+        # fell under FINEST and beat into moire).
         zig = np.abs(((n * u / np.pi) % 2) - 1)
-        h = np.sin(n * v + 2.0 * zig) ** 2 + 0.25 * grain
+        h = np.sin(n * v / 2 + 2.0 * zig) ** 2 + 0.25 * grain
     elif fabric.weave == "strands":
         wander = _noise(size, rng, 1, 6)
         h = np.sin(n * u + 6 * wander) * 0.5 + 0.5 + 0.3 * _noise(size, rng, 30, 120)
     else:  # leather grain: cells from high-frequency noise, wrinkles from low
         h = np.abs(_noise(size, rng, n // 2, n)) + 0.5 * _noise(size, rng, 2, 8)
     h = h - h.mean()
-    return (h / max(float(np.abs(h).max()), 1e-6)).astype(np.float32)
+    h = h / max(float(np.abs(h).max()), 1e-6)
+    if fabric.weave in ("knit", "plain"):
+        h = band_limited(h, TILE_METRES / FINEST)
+    return h.astype(np.float32)
+
+
+def band_limited(height: np.ndarray, cycles: float) -> np.ndarray:
+    """(S, S) a periodic height field with what is finer than ``cycles`` per tile faded
+    (a smooth roll-off over a sixth of that, down to FINE_FLOOR): a pre-filter, as a
+    mipmap would, for a renderer that has none."""
+    size = height.shape[0]
+    f = np.fft.fftfreq(size) * size
+    r = np.hypot(*np.meshgrid(f, f))
+    fade = np.exp(-((np.clip(r - cycles, 0, None) / (0.15 * cycles)) ** 2))
+    gain = FINE_FLOOR + (1 - FINE_FLOOR) * fade
+    return np.fft.ifft2(np.fft.fft2(height) * gain).real
 
 
 def normal_map(height: np.ndarray, depth: float) -> np.ndarray:
