@@ -378,9 +378,12 @@ def stubble(body: AuthoringBody) -> Piece:
     ``facial_hair.STUBBLE_SPAN_U``), v the height above the mouth on the face and, below
     the chin's tip, the distance down the skin from there (``STUBBLE_V``). Heights and
     angles alone squeezed the stubs into streaks under the chin, where the skin runs back
-    level and close to the head's axis. v below the mouth is scaled so the throat's edge
-    (2 cm under the chin) lands on ``STUBBLE_THROAT_M``; the atlas's density fades out at
-    the beard's cheek line, sideburns, throat and lips."""
+    level and close to the head's axis; under the chin and on the throat u is the arc
+    round the neck and v the distance down the face's midline profile
+    (``_down_the_face``). v is never stretched: where the cut reaches further down than
+    ``STUBBLE_THROAT_M`` the stubble thins out under the jaw, above the cut's edge (a
+    shorter face is squeezed onto it). The atlas's density fades out at the beard's cheek
+    line, sideburns, throat and lips."""
     from avatar.looks import facial_hair as fh
 
     faces = body.skin_faces
@@ -392,24 +395,79 @@ def stubble(body: AuthoringBody) -> Piece:
     normal *= np.sign(np.einsum("vd,vd->", normal, p - centre))  # outward, whatever the winding
     # u: the arc round the face at ARC_RADIUS_M (the atlas's cheek line is drawn in
     # angles); nearer the head's axis (under the chin, the throat), where that arc would
-    # squeeze the stubs, the distance from the midline over the skin.
+    # squeeze the stubs, the arc round the neck at the point's own distance from the
+    # neck's axis (under the chin, far in front of it, about x). (Measured over the cut's
+    # edges, it wound round the holes the mask leaves under the jaw: 10 cm for a point
+    # 2 cm off the midline; the skull's axis is 2 cm behind the throat: stubs squeezed
+    # 2.4 times across the throat.)
     axis = centre - [0.0, fh.STUBBLE_BACK_M, 0.0]
     angle = np.arctan2(p[:, 0], -(p[:, 1] - axis[1]))
-    midline = np.flatnonzero(np.abs(p[:, 0]) < 0.004)
-    across = np.sign(p[:, 0]) * _over_the_skin(mesh, midline, np.abs(p[midline, 0]))
     near = np.clip((fh.ARC_RADIUS_M - np.hypot(p[:, 0], p[:, 1] - axis[1])) / 0.02, 0, 1)
-    near *= np.clip((np.radians(60) - np.abs(angle)) / np.radians(20), 0, 1)  # not the sides
-    u_m = (1 - near) * angle * fh.ARC_RADIUS_M + near * across
+    # ... below the jaw or facing down under it, not on the cheeks.
+    near *= np.maximum(np.clip((chin_z + 0.01 - p[:, 2]) / 0.02, 0, 1),
+                       np.clip((-normal[:, 2] - 0.3) / 0.3, 0, 1))  # fmt: skip
+    neck = p[:, 1] - _neck_axis_y(body, chin_z - 0.035, centre)
+    u_m = (1 - near) * angle * fh.ARC_RADIUS_M + near * np.hypot(p[:, 0], neck) * np.arctan2(
+        p[:, 0], -neck)  # fmt: skip
     # v: the face's own height down to the chin's tip, then over the skin.
-    upright = np.flatnonzero((rel_z >= chin_z - mouth[2]) & (normal[:, 2] > -0.4))
-    down = -_over_the_skin(mesh, upright, np.maximum(-rel_z[upright], 0.0))
-    v_m = np.where(rel_z >= 0, rel_z, down)
+    v_m = np.where(rel_z >= 0, rel_z, _down_the_face(mesh, p, rel_z, normal, chin_z - mouth[2]))
+    # The atlas's stubble thins out STUBBLE_THROAT_M down the skin from the mouth (just
+    # under the jaw). A face whose cut reaches less far down is fitted to it (the stubs
+    # a little shorter); one that reaches further is not stretched to it (stubs half as
+    # long again under the chin): its stubble thins out under the jaw, before the cut.
     edge = np.median(v_m[np.abs(p[:, 2] - (chin_z - 0.02)) < 0.004])  # the throat's edge
-    v_m = np.where(v_m < 0, v_m * (fh.STUBBLE_THROAT_M / min(edge, -0.01)), v_m)
+    squeeze = max(1.0, fh.STUBBLE_THROAT_M / min(edge, -0.01))
+    # (Below the atlas, where no stubble grows, v stays on its last, empty row.)
+    v_m = np.maximum(np.where(v_m < 0, v_m * squeeze, v_m), fh.STUBBLE_V[0])
     u = (u_m / fh.STUBBLE_SPAN_U + 1) / 2
     v = (v_m - fh.STUBBLE_V[0]) / (fh.STUBBLE_V[1] - fh.STUBBLE_V[0])
     uv = np.stack([u, v], -1)[mesh.faces].reshape(-1, 2)
     return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
+
+
+def _neck_axis_y(body: AuthoringBody, z: float, centre: np.ndarray) -> float:
+    """y of the neck's vertical axis at height ``z``: the middle of its front-to-back
+    extent there (the skin within 10 cm of the skull's centre line)."""
+    skin = body.vertices[:BODY_VERTICES]
+    ring = skin[(np.abs(skin[:, 2] - z) < 0.004) & (np.abs(skin[:, 0]) < 0.1)
+                & (np.abs(skin[:, 1] - centre[1]) < 0.1)]  # fmt: skip
+    return float(ring[:, 1].min() + ring[:, 1].max()) / 2 if len(ring) else float(centre[1])
+
+
+def _down_the_face(mesh: Mesh, p: np.ndarray, rel_z: np.ndarray, normal: np.ndarray,
+                   chin: float) -> np.ndarray:  # fmt: skip
+    """(V,) m down from the mouth (negative) of the stubble's vertices below it: on the
+    upright face its height (``rel_z``); under the chin and down the throat the distance
+    over the skin from the chin's tip (``chin`` m below the mouth) along the face's
+    midline profile, taken at the nearest point of that profile seen from the side, so
+    that v runs straight down the throat whatever x. (Measured over the skin from the
+    whole upright face, it ran in from the jaw's sides as much as down from the chin: v
+    and u turned parallel on the throat and squeezed the stubs there 2.4 times.)"""
+    upright = (rel_z >= chin) & (normal[:, 2] > -0.4)
+    seeds = np.flatnonzero(upright & (np.abs(p[:, 0]) < 0.01))  # the chin's, not the jaw's
+    down = -_over_the_skin(mesh, seeds, np.maximum(-rel_z[seeds], 0.0))
+    profile = np.flatnonzero((np.abs(p[:, 0]) < 0.006) & ~upright)
+    if len(profile) < 3:
+        return np.where(upright, rel_z, down)
+    profile = profile[np.argsort(-down[profile])]  # from the chin down the throat
+    along = np.minimum(_along_polyline(p[profile, 1:], down[profile], p[:, 1:]), chin)
+    # Under the jaw above the chin's tip: also the height above it (v = the height where
+    # it meets the upright face; flat at the chin's, the stubs there were streaks).
+    return np.where(upright, rel_z, along + np.maximum(rel_z - chin, 0.0))
+
+
+def _along_polyline(line: np.ndarray, value: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(N,) ``value`` (L,) interpolated at the nearest point of the polyline ``line``
+    (L, 2) to each of ``points`` (N, 2)."""
+    a, b = line[:-1], line[1:]  # (S, 2) segments
+    d = b - a
+    t = np.einsum("nsd,sd->ns", points[:, None] - a[None], d) / np.maximum(
+        np.einsum("sd,sd->s", d, d), 1e-12)  # fmt: skip
+    t = np.clip(t, 0, 1)
+    gap = np.linalg.norm(points[:, None] - (a[None] + t[..., None] * d[None]), axis=2)
+    s = gap.argmin(axis=1)
+    k = np.arange(len(points))
+    return value[:-1][s] + t[k, s] * (value[1:][s] - value[:-1][s])
 
 
 def _over_the_skin(mesh: Mesh, seeds: np.ndarray, start: np.ndarray) -> np.ndarray:

@@ -32,7 +32,7 @@ ARC_RADIUS_M = 0.075  # stubble u: arc length round the face at about this radiu
 # mouth (a canonical adult's: ``clothes.face.stubble`` maps the throat's edge to STUBBLE_
 # THROAT_M). One tile of stubs repeats every STUBBLE_TILE_M across it.
 STUBBLE_SPAN_U = 0.135
-STUBBLE_V = (-0.11, 0.08)
+STUBBLE_V = (-0.13, 0.08)
 STUBBLE_THROAT_M = -0.074  # the beard's lower edge (2 cm under the chin), default adult
 STUBBLE_TILE_M = 0.03
 STUBBLE_INSET_M = 0.005  # stubble fades out this far inside the beard's cheek line
