@@ -308,7 +308,7 @@ def _beard_flow(centre: np.ndarray):
     return flow
 
 
-def beard(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:
+def beard(body: AuthoringBody, count: int = 2400, length=(0.007, 0.013)) -> Piece:
     """A short full beard: narrow strand cards rooted where ``facial_hair_density(body,
     "beard", ...)`` lets them grow, combed down the face, about a centimetre long, lying
     close to the skin, thinning out (sparser, shorter, flatter) over the last centimetre to
@@ -316,8 +316,8 @@ def beard(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piec
     rides the upper lip, the other the jaw, so opening the mouth parts them.
 
     One segment a card (4 vertices: a centimetre-long card bends over the jaw by a tenth
-    of a millimetre between its ends) and 2,200 cards 4.8 mm wide, which cover the face
-    as 3,600 cards 3.2 mm wide of two segments did: 8,800 vertices instead of 21,600."""
+    of a millimetre between its ends) and 2,400 cards 4.4 mm wide, which cover the face
+    as 3,600 cards 3.2 mm wide of two segments did: 9,600 vertices instead of 21,600."""
     centre, mouth, *_ = mouth_frame(body)
     keep = facial_hair_mask(body, "beard")
     c = body.vertices[body.skin_faces].mean(axis=1)
@@ -330,20 +330,26 @@ def beard(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piec
 
     return join([
         cards_on(body, keep & upper, flow, int(count * share), length, BEARD_CARD_M, lift,
-                 segments=1, density=density),
+                 segments=1, density=density, strip=BEARD_STRIP),
         cards_on(body, keep & ~upper, flow, count - int(count * share), length, BEARD_CARD_M,
-                 lift, segments=1, seed=2, density=density),
+                 lift, segments=1, seed=2, density=density, strip=BEARD_STRIP),
     ])  # fmt: skip
 
 
-BEARD_CARD_M = 0.0048  # a beard card's width: some fifteen hairs (the texture keeps 2 in 5)
+BEARD_CARD_M = 0.0044  # a beard card's width
+# A beard or moustache card shows this share of the hair texture's width: some six of
+# its kept hairs, each a few tenths of a millimetre (facial hair is coarse). Scalp cards'
+# 0.12 drew some forty hairs a tenth as thick, under a pixel at any distance: a felt.
+FACIAL_STRIP = 0.05
+BEARD_STRIP = 0.08  # (a short beard's hairs, a centimetre long, as dashes at 0.05)
 
 
 def moustache(body: AuthoringBody, count: int = 600) -> Piece:
     """A moustache: narrow strand cards (2.4 mm, a dozen hairs) over the upper lip, of
-    uneven length (a ragged lower edge), combed down and fanning out over it,
-    full under the nose and tapering to points at the corners of the mouth
-    (``facial_hair_density(body, "moustache", ...)``)."""
+    uneven length, combed down and fanning out over it, full under the nose and tapering
+    to points at the corners of the mouth (``facial_hair_density(body, "moustache",
+    ...)``). Along the lip the hair grows in locks of their own length (``_lip_locks``),
+    so its lower edge wanders over the lip instead of ending on one line."""
     centre, *_ = mouth_frame(body)
     keep = facial_hair_mask(body, "moustache")
 
@@ -351,7 +357,24 @@ def moustache(body: AuthoringBody, count: int = 600) -> Piece:
         return facial_hair_density(body, "moustache", points)
 
     return cards_on(body, keep, _moustache_flow(), count, (0.007, 0.015), 0.0024,
-                    (0.001, 0.0025), seed=1, density=density)  # fmt: skip
+                    (0.001, 0.0025), seed=1, density=density, reach=_lip_locks(),
+                    strip=FACIAL_STRIP)  # fmt: skip
+
+
+def _lip_locks(seed: int = 5, spread: float = 0.4):
+    """A factor on moustache cards' length by their place along the lip, points (N, 3) ->
+    (N,): locks 3-6 mm wide, each up to ``spread`` longer or shorter than the mean (the
+    cards' own random lengths alone averaged out, under 600 overlapping cards, into a
+    straight lower edge a millimetre from a line)."""
+    rng = np.random.default_rng(seed)
+    knots = np.arange(-MOUSTACHE_HALF_M - 0.006, MOUSTACHE_HALF_M + 0.006, 0.0045)
+    knots = knots + rng.uniform(-0.001, 0.001, len(knots))
+    factor = 1 + spread * rng.uniform(-1, 1, len(knots))
+
+    def reach(points: np.ndarray) -> np.ndarray:
+        return np.interp(points[:, 0], knots, factor)
+
+    return reach
 
 
 def _moustache_flow():

@@ -298,6 +298,8 @@ def cards_on(
     segments: int = 2,
     seed: int = 0,
     density=None,
+    reach=None,
+    strip: float = 0.12,
 ) -> Piece:
     """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
     ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
@@ -308,7 +310,11 @@ def cards_on(
     density: points (N, 3) -> (N,) 0..1, how thickly hair grows there (None: 1). A root
     survives with that probability, and where it is low (the region's soft edges) the
     cards are also shorter and lie flatter, so the hair thins out instead of ending at a
-    line. (At most ``count`` cards: roots are drawn three times over, then thinned.)"""
+    line. (At most ``count`` cards: roots are drawn three times over, then thinned.)
+
+    reach: roots (N, 3) -> (N,) a factor on the cards' length (None: 1), e.g. locks of
+    longer and shorter hair along a moustache's lower edge. strip: the share of the
+    texture's width across a card (less: fewer, coarser hairs, as ``_card_piece``)."""
     rng = np.random.default_rng([seed, count])
     roots = _scatter(body, keep, 3 * count, rng)
     grow = np.ones(len(roots)) if density is None else np.asarray(density(roots), float)
@@ -316,6 +322,8 @@ def cards_on(
     roots, grow = roots[pick], grow[pick]
     count = len(roots)
     size = rng.uniform(length[0], length[1], count) * (0.35 + 0.65 * grow)
+    if reach is not None:
+        size = size * np.asarray(reach(roots), float)
     top = rng.uniform(lift[0], lift[1], count) * (0.4 + 0.6 * grow)
     rows, point = [roots], roots
     for k in range(1, segments + 1):
@@ -325,7 +333,7 @@ def cards_on(
         rows.append(point)
     path = np.stack(rows, 1)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
-    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep])
+    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], strip=strip)
 
 
 def _scatter(body: AuthoringBody, keep: np.ndarray, count: int, rng) -> np.ndarray:
@@ -453,12 +461,13 @@ def long_cards(
 
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
                 surface: np.ndarray | None = None, taper=0.7,
-                tip_v: float = 0.0) -> Piece:  # fmt: skip
+                tip_v: float = 0.0, strip: float = 0.12) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
     (or to ``surface``, (S, 4) base-mesh faces of it), ``width`` m wide (a float or one per
     card, (N,)), narrowing to ``taper`` (a float or (N,)) of their width at the tips,
     their texture running from the roots (v = 0.5) to ``tip_v`` (0: the texture's
-    thinned-out strand tips; more: cut ends, as a blunt haircut has)."""
+    thinned-out strand tips; more: cut ends, as a blunt haircut has) and across a random
+    ``strip`` of its width (how many of its hairs a card shows)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
@@ -473,7 +482,7 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     u0 = rng.uniform(0, 1, count)[:, None]
     v = 0.5 - (0.5 - tip_v) * np.linspace(0, 1, k)[None, :]
     left = np.stack(np.broadcast_arrays(u0, v), -1)
-    uv = np.concatenate([left, left + [0.12, 0.0]], 1).reshape(-1, 2).astype(np.float32)
+    uv = np.concatenate([left, left + [strip, 0.0]], 1).reshape(-1, 2).astype(np.float32)
     mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
     mesh = Mesh(mesh.vertices, mesh.faces, uv, mesh.faces.copy())
     return bound(body, mesh, body.skin_faces if surface is None else surface)
