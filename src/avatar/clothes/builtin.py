@@ -56,13 +56,16 @@ class Spec:
 
 
 def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
-            snug: float | None = None) -> Piece:  # fmt: skip
+            snug: float | None = None, bridge: bool = False) -> Piece:  # fmt: skip
     """A garment cut from ``helper-tights``; ``band`` > 0: a rib/hem band that wide (m)
     along every open edge (``authoring.banded``); ``snug``: m off the skin a stretch
-    garment is laid at (``tailoring.hug_skin``) instead of ``ease`` off the shell."""
+    garment is laid at (``tailoring.hug_skin``) instead of ``ease`` off the shell;
+    ``bridge``: loose cloth spanning the body's hollows (``bridged``)."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     mesh = level_hems(cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX))
+    if bridge:
+        mesh = bridged(body, mesh)
     if snug is not None:
         points = tailoring.hug_skin(body, mesh.vertices.astype(np.float64), snug)
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
@@ -71,6 +74,25 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
     # A snug garment follows the skin itself on every body (the shell stands off the skin
     # by different amounts on different bodies: bound to it, the seat sagged again).
     return bound(body, mesh, body.skin_faces if snug is not None else faces)
+
+
+def bridged(body: AuthoringBody, mesh: Mesh, passes: int = 12) -> Mesh:
+    """Loose cloth over the body's hollows: smoothing passes that only ever move a vertex
+    outwards (along the skin's normal; a hem too, where it crosses a hollow). Cut from
+    the tights shell a long cardigan followed the cleft of the buttocks down into a 9 mm
+    pocket that rendered as a black hole on the lower back."""
+    v = mesh.vertices.astype(np.float64)
+    a = mesh.faces.reshape(-1)
+    b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
+    degree = np.maximum(np.bincount(a, minlength=len(v)) + np.bincount(b, minlength=len(v)), 1)
+    normal = body.outward(v)
+    for _ in range(passes):
+        total = np.zeros_like(v)
+        np.add.at(total, a, v[b])
+        np.add.at(total, b, v[a])
+        rise = np.einsum("nd,nd->n", total / degree[:, None] - v, normal)
+        v += np.clip(rise, 0, None)[:, None] * normal
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
@@ -101,6 +123,12 @@ def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
     return tailoring.blend_sides(body, piece, "helper-skirt")
 
 
+# m the waistband's top reaches above the hip joints on the authoring body (a mid rise,
+# over the iliac crest). At 7 cm jeans rode low on women (whose waist is higher over the
+# hip joints): the top of the seat and the small of the back showed.
+RISE = 0.095
+
+
 def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
               thread: str, taper: float = 0.9) -> Piece:  # fmt: skip
     """Jeans or trousers: cut from ``helper-tights`` to ``length`` along the leg, falling
@@ -110,7 +138,7 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
     and belt loops."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
-    mesh = cut(body, faces, bottom(length)(ff, body.marks), ease, relax=RELAX)
+    mesh = cut(body, faces, bottom(length, RISE)(ff, body.marks), ease, relax=RELAX)
     mesh = level_hems(Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang,
                                                    taper=taper).astype(np.float32), mesh.faces))
     panels = tailoring.Panels(mesh, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
@@ -494,8 +522,6 @@ def _hood_collar(body: AuthoringBody, top_mesh: Mesh) -> Piece:
     a crossover V ``COLLAR_V`` below the neck joint, the wearer's left half over the right.
     Each half is an elliptic tube (the folded double layer of the hood's edge with its
     drawstring channel), kept clear of the skin and the hoodie."""
-    from avatar.clothes import shoes
-
     m = body.marks
     centre, radius, height = neckline(top_mesh, m.neck)
     pieces = []
@@ -518,23 +544,60 @@ def _hood_collar(body: AuthoringBody, top_mesh: Mesh) -> Piece:
         # The roll's centre clears the skin by its own size (over the hoodie and, at the
         # back, over the bag's top); the per-vertex push below only mops up.
         gap = 0.011 + 0.005 * (1 - front) + radii.max(axis=1) + lift
+        axis_xy = np.asarray(centre, np.float64)
         for _ in range(3):  # pushed clear, then smoothed along (no horns over the trapezius)
-            path = shoes._at_least(body, path, gap)
+            path = _clear_outwards(body, path, gap, axis_xy)
             for _ in range(4):
                 path[1:-1] = 0.5 * path[1:-1] + 0.25 * (path[:-2] + path[2:])
-        path = shoes._at_least(body, path, gap)
+        path = _clear_outwards(body, path, gap, axis_xy)
         outward = np.concatenate([direction[:, :2], np.full((len(a), 1), 0.5)], 1)
         tube = _tube(path, outward, radii)
         ring_lift = np.concatenate([np.repeat(lift, 10), lift[[0, -1]]])
-        points = shoes._at_least(body, tube.vertices.astype(np.float64), 0.008 + ring_lift)
+        points = _clear_rings(body, tube.vertices.astype(np.float64), 0.008 + ring_lift,
+                              axis_xy, 10)  # fmt: skip
         tube = Mesh(points.astype(np.float32), tube.faces, tube.uvs, tube.face_uvs)
         pieces.append(bound(body, tube, body.group_faces("helper-tights")))
     return join(pieces)
 
 
+def _clear_outwards(body: AuthoringBody, points: np.ndarray, gap, axis_xy: np.ndarray,
+                    ) -> np.ndarray:  # fmt: skip
+    """(N, 3) points moved straight out from the vertical axis through ``axis_xy`` (2,)
+    until ``gap`` m (scalar or (N,)) off the skin: along the skin's normal (up and out
+    on the trapezius' slope) the hood's roll rose into horns either side of the neck and
+    its tube's underside went lumpy from behind."""
+    out = points.copy()
+    for _ in range(4):
+        need = np.linalg.norm(shoes._at_least(body, out, gap) - out, axis=1)
+        if need.max() < 1e-5:
+            break
+        radial = out[:, :2] - axis_xy
+        radial /= np.maximum(np.linalg.norm(radial, axis=1, keepdims=True), 1e-9)
+        facing = np.einsum("nd,nd->n", radial, body.outward(out)[:, :2])
+        out[:, :2] += radial * (need / np.clip(facing, 0.4, 1.0))[:, None]
+    return out
+
+
+def _clear_rings(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
+                 axis_xy: np.ndarray, segments: int) -> np.ndarray:  # fmt: skip
+    """A ``_tube``'s points (rings of ``segments``, then its two end centres) cleared as
+    ``_clear_outwards`` does, each ring moved as one (by its most pressed point), so the
+    tube stays round instead of dented where single points were pushed."""
+    rings = (len(points) - 2) // segments
+    body_part = points[: rings * segments]
+    moved = _clear_outwards(body, body_part, gap[: rings * segments], axis_xy)
+    shift = (moved - body_part).reshape(rings, segments, 3)
+    worst = np.argmax(np.linalg.norm(shift, axis=2), axis=1)
+    ring_shift = shift[np.arange(rings), worst]  # (rings, 3)
+    out = points.copy()
+    out[: rings * segments] += np.repeat(ring_shift, segments, axis=0)
+    out[rings * segments :] += ring_shift[[0, -1]]
+    return out
+
+
 def _hoodie(body: AuthoringBody) -> Piece:
     top_piece = _tights(body, top(0.95, neck=-HOODIE_NECK, hem=-0.02), sleeve_ease(0.013, 0.012),
-                        0.03)  # fmt: skip
+                        0.03, bridge=True)  # fmt: skip
     pocket = _tights(body, _kangaroo_pocket, 0.017, 0.012)
     collar = _hood_collar(body, top_piece.mesh)
     return join([top_piece, pocket, _hood(body), collar, _drawstrings(body)])
@@ -557,11 +620,11 @@ EYELASH_GROUPS = (
 )
 
 SPECS = [
-    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
-    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
+    Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014, bridge=True), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
+    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
-    Spec("jacket", "tops", lambda b: _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
-    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
+    Spec("jacket", "tops", lambda b: _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
+    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501

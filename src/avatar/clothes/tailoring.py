@@ -315,6 +315,9 @@ def trouser_marks(panels: Panels, h: Heights) -> list[Mark]:
         low = h.crotch - 0.04 if panel.back else h.band - 0.01
         z = np.linspace(h.hem + 0.005, low, 60)
         centre = (inner(np.minimum(z, h.crotch)) + outer(np.minimum(z, h.crotch))) / 2
+        # A pressed crease runs in one sweep: the panel's edges step with the helper
+        # mesh's faces (the crease between them jogged 8-10 mm sideways at the knee).
+        centre = np.polyval(np.polyfit(z, centre, 2), z)
         marks.append(Mark("crease", _line(panels, k, centre, z), 0.0025, 1.3))
         marks.append(Mark("fold", _across(panels, k, h.hem + 0.07, 0.02, 30, 0.004, k)[6:22],
                           0.006, 0.35 if not panel.back else 0.2))  # the break over the shoe
