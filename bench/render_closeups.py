@@ -61,9 +61,28 @@ SETS["hair"] = [  # issue 14's hair and facial-hair checks: ages, long and tied 
     ({"gender": 0.0, "age": 0.3}, ("eyebrows", "eyelashes", "hair-bob")),
     ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short", "cap")),
 ]  # fmt: skip
+SETS["looks5"] = [  # issue 14's hair after the fifth look pass: every style, child to elderly
+    ({"gender": 0.3, "age": 0.12}, ("eyebrows", "eyelashes", "hair-bob")),
+    ({"gender": 0.0, "age": 0.45}, ("eyebrows", "eyelashes", "hair-long")),
+    ({"gender": 0.0, "age": 0.35}, ("eyebrows", "eyelashes", "hair-ponytail")),
+    ({"gender": 1.0, "age": 0.25}, ("eyebrows", "eyelashes", "hair-short")),
+    ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short")),
+    ({"gender": 0.0, "age": 0.95}, ("eyebrows", "eyelashes", "hair-bun")),
+    ({"gender": 1.0, "age": 0.95}, ("eyebrows", "eyelashes", "hair-buzz")),
+]  # fmt: skip
+SETS["facial"] = [  # moustache, short beard and stubble, young and old, framed on the mouth
+    ({"gender": 1.0, "age": 0.5}, ("eyebrows", "eyelashes", "hair-short", "moustache")),
+    ({"gender": 1.0, "age": 0.95}, ("eyebrows", "eyelashes", "hair-short", "moustache")),
+    ({"gender": 1.0, "age": 0.45}, ("eyebrows", "eyelashes", "hair-short", "beard-short")),
+    ({"gender": 1.0, "age": 1.0, "weight": 0.8}, ("eyebrows", "eyelashes", "beard-short")),
+    ({"gender": 1.0, "age": 0.4}, ("eyebrows", "eyelashes", "hair-buzz", "stubble")),
+    ({"gender": 1.0, "age": 0.7, "african": 1.0, "asian": 0.0, "caucasian": 0.0}, ("eyebrows", "eyelashes", "hair-short", "stubble")),  # noqa: E501
+]  # fmt: skip
+HEAD_SETS = ("heads", "hair", "looks5", "facial")
 CROWN_AIM = 1.8 - 0.32  # tops: crowns put at 1.8 m (as heads), the camera on the shoulders
 # set -> (metres between bodies, frame height / width per body, aim height (m))
-FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM)}
+FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM),
+           "facial": (0.22, 1.0, 1.8 - 0.2)}  # fmt: skip
 # Per set: where the camera looks (z of the aim point relative to the aligned height, m),
 # and the views (name -> direction from subject to camera).
 VIEWS = {
@@ -88,7 +107,7 @@ def main() -> None:
     out = Path(args.out)
     chars = []
     chosen = SETS[args.set]
-    heads = args.set in ("heads", "hair")
+    heads = args.set in HEAD_SETS
     spacing, tall, aim = FRAMING.get(args.set, (SPACING if heads else 0.55, 1.0, None))
     for i, (params, names) in enumerate(chosen):
         human = Human(params).dressed(*names)  # stands on its shoes' soles

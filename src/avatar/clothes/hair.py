@@ -446,7 +446,10 @@ def long_cards(
     # Shorter cards end higher up: sample each path to a random fraction of its length.
     path = _shorten(path, rng.uniform(0.75, 1.0, count))
     t = np.linspace(0, 1, k)[None, :, None]
-    height = rng.uniform(layers[0], layers[1], count)[:, None, None] * np.sqrt(t)
+    # Lying on the scalp at the crown (under the cards grown there), the layers lifting
+    # over the first third of the length: rising as the square root of it, the locks'
+    # roots stood up to a centimetre off the crown, a dark ridge across the top.
+    height = rng.uniform(layers[0], layers[1], count)[:, None, None] * np.clip(t / 0.35, 0, 1)
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
