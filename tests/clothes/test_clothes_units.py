@@ -74,6 +74,32 @@ def test_winding_number_counts_overlapping_solids():
     assert known.tolist() == [1, 2, 1, 0]
 
 
+def test_a_point_as_near_another_sheet_of_skin_that_it_is_inside_is_inside():
+    """Skin passing into itself (cube B's face runs inside cube A, as an arm pressed into
+    the chest): a point inside A is as near A's face (inside it) as B's (outside it).
+    Whichever one float rounding makes the nearest, the query says inside, as the winding
+    number does (it said outside by 0.2 whenever B's face won: CMU 01_01 frame 1320 left a
+    T-shirt vertex 4.2 mm inside the baked file for that reason)."""
+    tris = np.concatenate([CUBE.faces[:, [0, 1, 2]], CUBE.faces[:, [0, 2, 3]]])
+    vertices = np.concatenate([CUBE.vertices, CUBE.vertices + [1.5, 0.0, 0.0]])
+    faces = np.concatenate([CUBE.faces, CUBE.faces + 8])
+    surface = collision.body_surface(faces)
+    # 0.2 from A's face y = 1 (inside A) and from B's face x = 0.5 (outside B)
+    points = np.array([[0.3, 0.8 + e, z] for e in (-2e-6, 0.0, 2e-6) for z in (-0.3, 0.0, 0.4)],
+                      np.float32)  # fmt: skip
+    q = collision.query(vertices, surface, points, k=16, sheets=True)
+    assert np.allclose(q.distance, -0.2, atol=1e-5), q.distance
+    assert collision.penetration(vertices, faces, points)[0] == len(points)
+    assert np.all(q.normal[:, 1] > 0.85)  # out through A's face y = 1 (normals blended)
+    winding = collision.winding_number(points, vertices, np.concatenate([tris, tris + 8]))
+    assert np.all(winding >= 1)
+    # Clearly nearer B's face (outside B by 0.1, inside A by 0.3 beyond the tie): the
+    # nearest skin decides, as before.
+    q = collision.query(vertices, surface, np.array([[0.4, 0.7, 0.0]], np.float32), k=16,
+                        sheets=True)  # fmt: skip
+    assert np.isclose(q.distance[0], 0.1, atol=1e-5)
+
+
 def test_closest_points_on_triangles_match_dense_sampling():
     """The closest point found on each random triangle is as close as the best of 5,151
     points sampled over it, and no sample is closer (within the sampling step)."""

@@ -320,15 +320,15 @@ class _Job:
         unknown = suspect[np.isnan(clearance[moved[suspect]])]
         if len(unknown) and window.checked:  # a first check (often the only one) skips it
             exact = window.exact[i][t, moved[unknown]]
-            clearance[moved[unknown]] = skin.query(exact, k=6).distance
+            clearance[moved[unknown]] = skin.query(exact, k=6, sheets=True).distance
             suspect = self._suspects(window, i, t, moved, points)
         if not len(suspect):
             return suspect, np.zeros((0, 3), np.float32)
-        q = skin.query(points[suspect], k=6)
+        q = skin.query(points[suspect], k=6, sheets=True)  # skin pressed into skin: inside
         deep = suspect[q.distance < -self.bound]
         pushed = (q.closest + MARGIN * q.normal)[q.distance < -self.bound]
         if len(deep):
-            caught = skin.query(pushed, k=6).distance < -self.bound
+            caught = skin.query(pushed, k=6, sheets=True).distance < -self.bound
             caught &= clearance[moved[deep]] >= -self.bound + SLACK
             pushed[caught] = window.exact[i][t, moved[deep[caught]]]
         return deep, pushed
