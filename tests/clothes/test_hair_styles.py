@@ -150,3 +150,18 @@ def test_bob_ends_turn_in_and_vary_in_length(body):
 
     assert np.median(from_axis(lines[back, -1]) - from_axis(lines[back, -3])) < -0.006
     assert lines[back, -1, 2].std() > 0.006  # was 2.3 mm
+
+
+def test_long_hair_lies_on_the_scalp_over_the_head(body):
+    """Over the head the long locks lie on the scalp, under the hair grown there (they
+    hung from MakeHuman's hair ribbons, which stand off the crown, and lifted at once:
+    10 mm off it in the median, up to 28, a dark ridge of wide cards across the top)."""
+    from avatar.geometry import collision
+
+    _, eye_z = hair.head_frame(body)
+    surface = collision.skin_surface(body.base.faces[body.base.face_groups["body"]])
+    v = hair.long_cards(body).mesh.vertices
+    top = v[v[:, 2] > eye_z + 0.02]
+    height = collision.query(body.vertices[:13380], surface, top).distance
+    assert len(top) > 1000
+    assert np.median(height) < 0.006 and np.percentile(height, 90) < 0.012

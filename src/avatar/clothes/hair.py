@@ -364,7 +364,8 @@ def _above_skin(body: AuthoringBody, points: np.ndarray, height: np.ndarray) -> 
     return on + np.asarray(height)[:, None] * n
 
 
-def guides(body: AuthoringBody, samples: int = 16, behind: bool = True) -> np.ndarray:
+def guides(body: AuthoringBody, samples: int = 16, behind: bool = True,
+           bunch: float = 1.0) -> np.ndarray:  # fmt: skip
     """(G, samples, 3) guide curves of long hair from MakeHuman's ``helper-hair`` ribbons
     (which its targets reshape with every body): each ribbon's centre line from the crown
     to the tip, resampled evenly by length. The short fringe ribbons over the face are left
@@ -387,12 +388,28 @@ def guides(body: AuthoringBody, samples: int = 16, behind: bool = True) -> np.nd
         mesh = Mesh(points.astype(np.float32), local.reshape(ribbon.shape).astype(np.int32))
         row = np.round(strip_uvs(mesh, top)[:, 0] * (len(points) // 2 - 1)).astype(int)
         line = np.stack([points[row == r].mean(0) for r in range(row.max() + 1)])
-        curves.append(_resample(line, samples))
+        curves.append(_resample(line, samples, bunch))
     out = np.stack(curves)
     # Ordered from one side round the back to the other: measured from the front, the
     # angle jumps from +180 to -180 degrees at the back's midline, which put the two
     # curves either side of it at the two ends of the order, never blended (a seam).
     return out[np.argsort(np.arctan2(out[:, -1, 0], out[:, -1, 1] - centre[1]))]
+
+
+def _onto_the_scalp(body: AuthoringBody, curves: np.ndarray, lift: float = 0.004) -> np.ndarray:
+    """(G, K, 3) guide curves laid down onto the scalp over the head (at most ``lift`` m
+    off it above eye level, freed over the 6 cm below): MakeHuman's hair ribbons stand
+    5-18 mm off the crown, and the locks hung from them stood up above the hair grown
+    there, a dark ridge of wide cards across the top of the head."""
+    _, eye_z = head_frame(body)
+    points = curves.reshape(-1, 3).astype(np.float64)
+    _, i = body.skin_tree.query(points)
+    n = body.skin_normals[i].astype(np.float64)
+    height = np.einsum("nd,nd->n", points - body.vertices[i], n)
+    free = np.clip((eye_z - points[:, 2]) / 0.06, 0, 1)
+    cap = lift + free * np.maximum(height - lift, 0)
+    laid = _above_skin(body, points, np.minimum(height, cap))
+    return laid.reshape(curves.shape)
 
 
 def _components(faces: np.ndarray) -> list[np.ndarray]:
@@ -409,10 +426,12 @@ def _components(faces: np.ndarray) -> list[np.ndarray]:
     return [faces[piece == k] for k in np.unique(piece)]
 
 
-def _resample(line: np.ndarray, samples: int) -> np.ndarray:
-    """(samples, 3) points evenly spaced by arc length along a polyline (P, 3)."""
+def _resample(line: np.ndarray, samples: int, bunch: float = 1.0) -> np.ndarray:
+    """(samples, 3) points spaced by arc length along a polyline (P, 3): evenly, or with
+    ``bunch`` > 1 closer together towards its start (the fraction of the length at
+    sample i is (i / (samples - 1)) ** bunch)."""
     along = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))])
-    t = np.linspace(0, along[-1], samples)
+    t = np.linspace(0, 1, samples) ** bunch * along[-1]
     return np.stack([np.interp(t, along, line[:, k]) for k in range(3)], 1)
 
 
@@ -435,7 +454,8 @@ def long_cards(
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
     """
     rng = np.random.default_rng([seed, count])
-    g = guides(body, samples)
+    # Samples closer together over the head, where the guides bend over the skull.
+    g = _onto_the_scalp(body, guides(body, samples, bunch=1.7))
     pairs = [(i, i + 1) for i in range(len(g) - 1)
              if np.linalg.norm(g[i, -1] - g[i + 1, -1]) < 0.15]  # fmt: skip
     pick = rng.integers(0, len(pairs), count)
@@ -446,10 +466,13 @@ def long_cards(
     # Shorter cards end higher up: sample each path to a random fraction of its length.
     path = _shorten(path, rng.uniform(0.75, 1.0, count))
     t = np.linspace(0, 1, k)[None, :, None]
-    # Lying on the scalp at the crown (under the cards grown there), the layers lifting
-    # over the first third of the length: rising as the square root of it, the locks'
-    # roots stood up to a centimetre off the crown, a dark ridge across the top.
-    height = rng.uniform(layers[0], layers[1], count)[:, None, None] * np.clip(t / 0.35, 0, 1)
+    # Lying on the scalp over the head (under the cards grown there), the layers lifting
+    # from eye level down over 6 cm: rising from the crown as the square root of their
+    # length, the locks' roots stood a centimetre or two off the top of the head, a dark
+    # ridge of wide cards across it.
+    _, eye_z = head_frame(body)
+    below = np.clip((eye_z - path[..., 2:]) / 0.06, 0, 1)
+    height = rng.uniform(layers[0], layers[1], count)[:, None, None] * below * np.sqrt(t)
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
