@@ -36,13 +36,15 @@ HEEL = 0.014
 WELT = 0.003
 ARCH = 0.006  # m the tread is lifted between heel block and ball of the foot
 SPRING = 0.012  # m the tread curls up at the tip of the toe box (toe spring)
-CAP_EASE = EASE + 0.0007  # a toe cap sewn flat on the vamp, not a shell over it
+CAP_EASE = EASE + 0.0012  # a toe cap sewn flat on the vamp, not a shell over it
 # The upper's faces end OPEN_BOTTOM m above the foot's lowest point, then its bottom
 # edge is drawn down to EDGE m above it (the sole covers it): left where the faces ended
 # it wandered 2.5-15 mm above the ground, and the sole's edge with it (a clog's slab);
 # cutting the faces lower let the toes' bumps through the leather.
 OPEN_BOTTOM = 0.012
 EDGE = 0.002
+SOCK_ROOM = 0.001  # m a smoothed toe box may sink inside the cut (a sock is 2 mm inside)
+DRAWN_CLEAR = 0.003  # m over the ease the drawn edge keeps: room for a sock where the foot flares
 LACES = 5  # bars across the instep
 
 # Atlas rows (v0, v1) in the shoe material: leather upper, toe cap, sole rubber, laces.
@@ -99,15 +101,15 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
 
 
 def _drawn_down(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float = EASE) -> Mesh:
-    """The upper (or toe cap) with its bottom edge drawn straight down to EDGE m above the
-    ground, the tip curling up with the sole's toe spring (the sole can only curl as far
-    as the edge it covers), still ``ease`` off the skin."""
+    """The upper with its bottom edge drawn straight down to EDGE m above the ground, the
+    tip curling up with the sole's toe spring (the sole can only curl as far as the edge
+    it covers), still ``ease`` + DRAWN_CLEAR off the skin."""
     v = mesh.vertices.astype(np.float64)
     loop = _lowest_loop(mesh)
     loop = loop[v[loop, 2] < foot.ground + OPEN_BOTTOM + 0.01]  # a toe cap's back edge stays
     spring = SPRING * np.clip((foot.along(v[loop]) - 0.84) / 0.2, 0, 1) ** 2
     v[loop, 2] = np.minimum(v[loop, 2], foot.ground + EDGE + spring)
-    v[loop] = _at_least(body, v[loop], ease)
+    v[loop] = _at_least(body, v[loop], ease + DRAWN_CLEAR)
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
@@ -116,7 +118,7 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     centre = body.vertices[faces].mean(axis=1)
     keep = _shoe_faces(body, foot, faces) & (foot.along(centre) > 0.78)
     mesh = cut(body, faces, keep, CAP_EASE, relax=8)
-    mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, CAP_EASE), CAP_EASE)
+    mesh = _toe_box(body, foot, mesh, CAP_EASE)  # drawn down too, a sock showed at its corner
     return bound(body, _planar_uvs(mesh, "cap"), faces)
 
 
@@ -125,6 +127,7 @@ def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float) -> Mesh:
     shell, then every vertex at least ``ease`` off the skin again), the front drawn out a
     centimetre past the toes into a rounded box."""
     v = mesh.vertices.astype(np.float64)
+    v0 = v.copy()
     a = mesh.faces.reshape(-1)
     b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
     degree = np.bincount(a, minlength=len(v)) + np.bincount(b, minlength=len(v))
@@ -144,10 +147,16 @@ def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float) -> Mesh:
     front = np.clip((t - 0.6) / 0.4, 0, 1) ** 2
     v[:, 1] -= 0.016 * front  # the toe box reaches past the toes
     # ... and slopes down to its tip (a last's toe, not a clog's blunt dome): in front of
-    # the toes the height over the sole taken down by up to 40% (over the toes their
-    # clearance would push the bumps of the toes back into the leather).
-    tip = np.clip((t - 0.8) / 0.25, 0, 1) ** 2
+    # the toes the height over the sole taken down by up to 40% (over the toes it pushed
+    # the bumps of the toes back into the leather, and a sock through it).
+    tip = np.clip((t - 0.93) / 0.15, 0, 1) ** 2
     v[:, 2] -= 0.4 * tip * np.clip(v[:, 2] - foot.ground - 0.008, 0, None)
+    # Smoothing pulls the convex parts in (the little toe's joint), where the shell stands
+    # well off the skin: a sock cut from the shell showed through. Each vertex stays within
+    # SOCK_ROOM inside the cut's own surface, and ``ease`` off the skin.
+    normal0 = body.outward(v0)
+    inward = np.einsum("nd,nd->n", v - v0, normal0)
+    v += np.clip(-SOCK_ROOM - inward, 0, None)[:, None] * normal0
     v = _at_least(body, v, ease)
     # Fill the hollows between toes: smoothing that only ever moves a vertex outwards.
     normal = body.outward(v)
@@ -186,6 +195,10 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     across = np.abs(low @ np.stack([-out[:, 1], out[:, 0]], 1).T)  # sideways from that ray
     reach = np.where(across < 0.012, reach, -np.inf).max(axis=0)
     extra = np.clip(reach - np.einsum("nd,nd->n", ring[:, :2] - centre[:2], out), 0, None)
+    # A smooth outline in plan (it wavily followed the upper's faces): averaged round the
+    # ring (widening it over the neighbours first lifted a settled pose off its soles).
+    for _ in range(3):
+        extra = 0.5 * extra + 0.25 * (np.roll(extra, 1) + np.roll(extra, -1))
     ring = ring.copy()
     ring[:, :2] += extra[:, None] * out
     t = foot.along(ring)
