@@ -150,6 +150,13 @@ def test_bob_ends_turn_in_and_vary_in_length(body):
 
     assert np.median(from_axis(lines[back, -1]) - from_axis(lines[back, -3])) < -0.006
     assert lines[back, -1, 2].std() > 0.006  # was 2.3 mm
+    # Turned, not folded: no card bends back on itself (ends curled into the nape and
+    # pushed back out folded by up to 165 degrees).
+    step = np.diff(lines, axis=1)
+    step /= np.maximum(np.linalg.norm(step, axis=2, keepdims=True), 1e-12)
+    bend = np.degrees(np.arccos(np.clip(np.einsum("nkd,nkd->nk", step[:, 1:], step[:, :-1]),
+                                        -1, 1)))  # fmt: skip
+    assert bend.max() < 60
 
 
 def test_long_hair_lies_on_the_scalp_over_the_head(body):

@@ -88,7 +88,7 @@ def scalp(body: AuthoringBody, ease: float, front=0.05, side=0.03, back=-0.045) 
 # the temple: a corner raised at 45 degrees (a receding temple) showed as a notch where
 # hair is drawn back (a ponytail, a bun).
 HAIRLINE_DEG = (0, 30, 45, 60, 72, 76, 84, 88, 112, 120, 140, 180)
-HAIRLINE_M = (0.07, 0.067, 0.062, 0.048, 0.03, -0.012, -0.012, 0.035, 0.035, -0.02, -0.055, -0.065)
+HAIRLINE_M = (0.07, 0.068, 0.066, 0.05, 0.03, -0.012, -0.012, 0.035, 0.035, -0.02, -0.055, -0.065)
 
 
 def head_frame(body: AuthoringBody) -> tuple[np.ndarray, float]:
@@ -635,10 +635,7 @@ def hang_cards(
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
-    # Layered: a third of the cards end up to 2.5 cm above the line (the cut's outer
-    # layers), so the ends vary in length instead of one box edge.
-    layer = ~front & (rng.uniform(size=count) < 0.35)
-    stop[layer] += rng.uniform(0.008, 0.025, layer.sum())
+    stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
     path = _curl_in(body, _cut_at(path, stop), centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
@@ -647,18 +644,40 @@ def hang_cards(
     return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
 
 
+def _layers(path: np.ndarray, centre: np.ndarray, free: np.ndarray, rng) -> np.ndarray:
+    """(N,) m by which hanging cards (paths (N, K, 3)) end above their cut: a third of the
+    ``free`` ones hanging behind the neck end 0.8-2.5 cm higher (the cut's outer layers,
+    so the ends vary in length instead of one box edge). Not by the face: resampled
+    shorter, a card's points cut across the temple's curve, into a face fuller than the
+    authoring body's."""
+    behind = free & (path[:, -1, 1] > centre[1] + 0.02)
+    return np.where(behind & (rng.uniform(size=len(path)) < 0.35),
+                    rng.uniform(0.008, 0.025, len(path)), 0.0)  # fmt: skip
+
+
 def _curl_in(body: AuthoringBody, path: np.ndarray, centre: np.ndarray,
              reach: float = 0.035, depth: float = 0.012) -> np.ndarray:  # fmt: skip
     """(N, K, 3) hanging paths whose last ``reach`` m turn in towards the head's vertical
-    axis by up to ``depth`` m at the tips (a bob's ends curl under; hanging straight down
-    they ended in a box edge), kept 2 mm off the skin."""
+    axis (through ``centre``, the skull's centre at eye height) by up to ``depth`` m at
+    the tips (a bob's ends curl under; hanging straight down they ended in a box edge),
+    kept 2 mm off the skin."""
     seg = np.linalg.norm(np.diff(path, axis=1), axis=2)
     arc = np.concatenate([np.zeros((len(path), 1)), np.cumsum(seg, axis=1)], 1)
     s = np.clip((arc - (arc[:, -1:] - reach)) / reach, 0, 1)  # 0 above, 1 at the tip
+    # Only the ends at the cut, below the cheekbones (``centre`` is at eye height): short
+    # cards ending by the temples turned in towards the face and kinked.
+    s = s * (path[:, -1:, 2] < centre[2] - 0.05)
     inward = (centre - path) * np.array([1.0, 1.0, 0.0])
     inward /= np.maximum(np.linalg.norm(inward, axis=-1, keepdims=True), 1e-9)
-    curled = path + (depth * s**2)[..., None] * inward
-    return _off_skin(body, curled.reshape(-1, 3), 0.002).reshape(path.shape)
+    # No further in than the room left to the skin over the card's curled part (curled
+    # into the nape and pushed back out, ends folded back on themselves).
+    room, _ = body.skin_tree.query(path.reshape(-1, 3))
+    room = np.where(s > 0, room.reshape(s.shape), np.inf).min(axis=1, keepdims=True)
+    shift = np.minimum(depth, np.maximum(room - 0.006, 0)) * s**2
+    curled = path + shift[..., None] * inward
+    moved = shift > 0  # (the others are where ``hang_cards`` put them, off the skin)
+    curled[moved] = _off_skin(body, curled[moved], 0.002)
+    return curled
 
 
 def _off_skin(body: AuthoringBody, points: np.ndarray, gap) -> np.ndarray:
