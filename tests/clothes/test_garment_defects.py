@@ -645,3 +645,74 @@ def test_hems_and_their_bands_run_level(name):
         p = v[loop] - v[loop].mean(axis=0)
         normal = np.linalg.svd(p)[2][2]
         assert np.abs(p @ normal).max() < 0.0015, (name, len(loop), np.abs(p @ normal).max())
+
+
+# ---------------------------------------------------------------------------- back midline
+
+MUSCULAR_MAN = {"gender": 1.0, "age": 0.3, "muscle": 0.8}
+BACKS = [MUSCULAR_MAN, None, {"gender": 0.0, "age": 0.9, "weight": 0.7},
+         {"gender": 1.0, "weight": 1.0}]  # fmt: skip
+
+
+def _side_neighbours(v: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) each vertex's edge neighbour furthest to its left (-x) and right (+x); itself
+    where it has none."""
+    a = np.concatenate([faces.reshape(-1), np.roll(faces, -1, axis=1).reshape(-1)])
+    b = np.concatenate([np.roll(faces, -1, axis=1).reshape(-1), faces.reshape(-1)])
+    dx = v[b, 0] - v[a, 0]
+    sides = []
+    for pick in (-dx, dx):
+        side, best = np.arange(len(v)), np.zeros(len(v))
+        np.maximum.at(best, a, pick)
+        chosen = (pick > 0) & (pick == best[a])
+        side[a[chosen]] = b[chosen]
+        sides.append(side)
+    return sides[0], sides[1]
+
+
+def _fold_angles(v: np.ndarray, faces: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """Degrees between the normals of every two kept faces that share an edge."""
+    q = v[faces]
+    normal = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(faces)), faces.shape[1])
+    order = np.lexsort(edges.T[::-1])
+    edges, owner = edges[order], owner[order]
+    shared = np.all(edges[1:] == edges[:-1], axis=1)
+    a, b = owner[:-1][shared], owner[1:][shared]
+    both = keep[a] & keep[b]
+    cos = np.einsum("nd,nd->n", normal[a[both]], normal[b[both]])
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+@pytest.mark.parametrize("name", ["hoodie", "cardigan", "jacket", "tshirt"])
+@pytest.mark.parametrize("params", BACKS)
+def test_loose_tops_span_the_cleft_without_folding_into_it(name, params):
+    """Over the cleft of the buttocks the skin's normals point at the other side: eased
+    along them (and bound to the cleft's walls) the two halves of a top crossed over at
+    the back midline, a 60-130 degree fold and a 5.5-6.7 mm groove (the thin dark slit
+    above the muscular man's hoodie hem). Between the band and 20 cm above the hem, on
+    four bodies: the midline lies no more than 3 mm below its left and right neighbours,
+    and no two faces of the back's middle (at least 4 mm wide) meet at over 45 degrees."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    human = Human(params).dressed(name)
+    fitted = human.outfit.garments[0]
+    count = len(fitted.garment.mesh.vertices)
+    v = fitted.mesh.vertices[:count].astype(np.float64)
+    faces = fitted.garment.mesh.faces
+    hip = AuthoringBody(human.body).marks.hip[0]
+    hem = v[:, 2].min()
+    seat = (v[:, 1] > hip[1]) & (v[:, 2] > hem + 0.045) & (v[:, 2] < hem + 0.2)
+    left, right = _side_neighbours(v, faces)
+    mid = seat & (np.abs(v[:, 0]) < 0.002) & (left != right)
+    assert mid.sum() >= 3
+    groove = (v[left, 1] + v[right, 1]) / 2 - v[:, 1]
+    assert groove[mid].max() < 0.003, groove[mid].max()
+    q = v[faces]
+    area = np.linalg.norm(np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1]), axis=1) / 2
+    longest = np.linalg.norm(q - np.roll(q, -1, axis=1), axis=2).max(axis=1)
+    middle = seat[faces].all(axis=1) & (np.abs(q[:, :, 0]).max(axis=1) < 0.03)
+    fold = _fold_angles(v, faces, middle & (area / longest > 0.004))
+    assert fold.max() < 45, fold.max()

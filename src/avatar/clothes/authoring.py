@@ -18,7 +18,7 @@ from avatar.body.model import BODY_VERTICES
 from avatar.body.shaped import Body
 from avatar.clothes import regions
 from avatar.clothes.binder import bind
-from avatar.clothes.binding import Binding, make_binding
+from avatar.clothes.binding import Binding, axis_scale, make_binding
 from avatar.geometry.shell import boundary_edges
 from avatar.looks.fabrics import TILE_METRES
 from avatar.looks.tailored import Layout
@@ -100,10 +100,43 @@ def cut(
     if callable(ease):
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
-    points = points + np.asarray(ease)[..., None] * normals
+    points = points + on_their_side(points, np.asarray(ease)[..., None] * normals)
     ridge = float(body.marks.shoulder[:, 1].mean())
     mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local), ridge_y=ridge)
     return with_limb_uvs(mesh, body.part[used], body.marks)
+
+
+MIDPLANE = 1e-5  # m: a vertex this close to x = 0 lies on the body's plane of symmetry
+CLEFT = 0.01  # m either side of the midplane: the half-width of the cleft of the buttocks
+
+
+def on_their_side(points: np.ndarray, moves: np.ndarray, keep_length: bool = True) -> np.ndarray:
+    """``moves`` (N, 3) m of ``points`` (N, 3), less their sideways part wherever it would
+    carry a vertex across the body's midplane (x = 0), off it, over halfway to it or, within
+    ``CLEFT`` of it, any nearer (``keep_length``: rescaled
+    to their length, so an ease still clears the skin by as much).
+
+    In a cleft (of the buttocks, between the breasts) the skin's normals point at the other
+    side: eased along them the vertices either side of the midline crossed over (the left
+    wall's 1 cm to the right of the right wall's), folding the cloth into itself, a thin
+    dark slit on the back of every top. A move kept to its own side still clears the skin
+    (its normal's other components point out of it too)."""
+    moves = np.array(moves, dtype=np.float64)
+    x = points[:, 0]
+    on_plane = np.abs(x) < MIDPLANE
+    # Halfway to the plane at most, and not at all within a cleft's width of it: closer,
+    # the faces between a vertex and its mirror image collapse to slivers turning every way.
+    towards = (x + moves[:, 0]) * np.sign(x) < np.where(np.abs(x) < CLEFT, np.abs(x), np.abs(x) / 2)
+    crosses = on_plane | towards
+    if not crosses.any() or not keep_length:
+        moves[crosses, 0] = 0.0
+        return moves
+    length = np.linalg.norm(moves[crosses], axis=1)
+    kept = moves[crosses] * np.array([0.0, 1.0, 1.0])
+    kept_length = np.linalg.norm(kept, axis=1)
+    scale = np.divide(length, kept_length, out=np.zeros_like(length), where=kept_length > 1e-9)
+    moves[crosses] = kept * scale[:, None]
+    return moves
 
 
 def surface_normals(body: AuthoringBody, faces: np.ndarray) -> np.ndarray:
@@ -144,7 +177,9 @@ def relax_boundary(
 
     def settle(moved: np.ndarray, which: np.ndarray) -> None:
         step = moved - origin[which]
-        p[which] = moved - np.einsum("nd,nd->n", step, n[which])[:, None] * n[which]
+        step -= np.einsum("nd,nd->n", step, n[which])[:, None] * n[which]
+        # A hem across a cleft: the walls' tangent planes slid its vertices past each other.
+        p[which] = origin[which] + on_their_side(origin[which], step, keep_length=False)
 
     for _ in range(passes):
         for weight in (0.5, -0.53):
@@ -235,9 +270,44 @@ def with_limb_uvs(mesh: Mesh, part: np.ndarray, marks, tile: float = TILE_METRES
     return Mesh(mesh.vertices, mesh.faces, uvs.reshape(-1, 2).astype(np.float32), mesh.face_uvs)
 
 
-def bound(body: AuthoringBody, mesh: Mesh, surface_faces: np.ndarray) -> Piece:
-    """Bind a mesh on the authoring body to a surface (base-mesh faces)."""
-    return Piece(mesh, bind(mesh.vertices, body.vertices, surface_faces))
+def bound(
+    body: AuthoringBody, mesh: Mesh, surface_faces: np.ndarray, midline: float = 0.0
+) -> Piece:
+    """Bind a mesh on the authoring body to a surface (base-mesh faces); ``midline`` > 0:
+    the vertices on the back within that many m of the midplane by ``across_the_cleft``."""
+    binding = bind(mesh.vertices, body.vertices, surface_faces)
+    if midline > 0:
+        binding = across_the_cleft(body, mesh.vertices, binding, surface_faces, midline)
+    return Piece(mesh, binding)
+
+
+def across_the_cleft(body: AuthoringBody, points: np.ndarray, binding: Binding,
+                     surface_faces: np.ndarray, width: float) -> Binding:  # fmt: skip
+    """``binding`` with the points (N, 3) on the back within ``width`` m of the midplane
+    re-anchored half-way between their nearest surface vertex and its mirror image, their
+    sideways offset scaling with the body's width.
+
+    Cloth spanning the cleft of the buttocks was bound to the cleft's nearest wall; on
+    another body the wall turned and the fixed offset carried the vertices on the midline
+    past their neighbours (a heavy man's hoodie folded 174 degrees into itself, a thin
+    dark slit above the hem). Anchored on the midplane they keep their side and order on
+    every (symmetric) body, and follow the height of the walls beside them."""
+    v = np.asarray(points, dtype=np.float64)
+    x = body.vertices.astype(np.float64)
+    pick = np.flatnonzero((np.abs(v[:, 0]) < width) & (v[:, 1] > body.marks.hip[0, 1]))
+    if len(pick) == 0:
+        return binding
+    shell = np.unique(surface_faces)
+    tree = cKDTree(x[shell])
+    near = shell[tree.query(v[pick])[1]]
+    mirror = shell[tree.query(x[near] * np.array([-1.0, 1.0, 1.0]))[1]]
+    indices, weights = binding.indices.copy(), binding.weights.copy()
+    offsets = binding.offsets.copy()
+    indices[pick] = np.stack([near, mirror, near], axis=1)
+    weights[pick] = (0.5, 0.5, 0.0)
+    anchor = (x[near] + x[mirror]) / 2
+    offsets[pick] = (v[pick] - anchor) / axis_scale(binding, x)
+    return make_binding(indices, weights, offsets, binding.scale_refs, binding.scale_lengths)
 
 
 def single_references(body: AuthoringBody, group: str, uvs_from_base: bool = True) -> Piece:

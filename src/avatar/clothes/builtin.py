@@ -23,6 +23,7 @@ from avatar.clothes.authoring import (
     cut,
     join,
     level_hems,
+    on_their_side,
     orient_outward,
     with_box_uvs,
 )
@@ -73,7 +74,9 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
         mesh = level_hems(banded(mesh, band), reach=0.012)
     # A snug garment follows the skin itself on every body (the shell stands off the skin
     # by different amounts on different bodies: bound to it, the seat sagged again).
-    return bound(body, mesh, body.skin_faces if snug is not None else faces)
+    if snug is not None:
+        return bound(body, mesh, body.skin_faces)
+    return bound(body, mesh, faces, midline=MIDLINE_SPAN / 2 if bridge else 0.0)
 
 
 def bridged(body: AuthoringBody, mesh: Mesh, passes: int = 12) -> Mesh:
@@ -86,13 +89,39 @@ def bridged(body: AuthoringBody, mesh: Mesh, passes: int = 12) -> Mesh:
     b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
     degree = np.maximum(np.bincount(a, minlength=len(v)) + np.bincount(b, minlength=len(v)), 1)
     normal = body.outward(v)
+    start = v.copy()
+    left, right = _side_neighbours(v, np.concatenate([a, b]), np.concatenate([b, a]))
+    midline = np.abs(v[:, 0]) < MIDLINE_SPAN
     for _ in range(passes):
         total = np.zeros_like(v)
         np.add.at(total, a, v[b])
         np.add.at(total, b, v[a])
         rise = np.einsum("nd,nd->n", total / degree[:, None] - v, normal)
-        v += np.clip(rise, 0, None)[:, None] * normal
+        # A cleft runs down the midline while the buttocks bulge across it: the mean of all
+        # four neighbours sat level with a 1 cm deep groove (those above and below it lie in
+        # the cleft too), so near the midline the cloth also spans from side to side.
+        across = np.einsum("nd,nd->n", (v[left] + v[right]) / 2 - v, normal)
+        rise = np.where(midline, np.maximum(rise, across), rise)
+        lifted = v + np.clip(rise, 0, None)[:, None] * normal
+        v = start + on_their_side(start, lifted - start, keep_length=False)
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+MIDLINE_SPAN = 0.04  # m either side of the midplane where loose cloth spans a cleft
+
+
+def _side_neighbours(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) index of each vertex's neighbour furthest to its left (-x) and to its right
+    (+x) along the edges a -> b (each edge both ways); a vertex itself where it has none."""
+    count = len(v)
+    dx = v[b, 0] - v[a, 0]
+    left, right = np.arange(count), np.arange(count)
+    for side, pick in ((left, -dx), (right, dx)):
+        best = np.zeros(count)
+        np.maximum.at(best, a, pick)
+        chosen = (pick > 0) & (pick == best[a])
+        side[a[chosen]] = b[chosen]
+    return left, right
 
 
 def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
