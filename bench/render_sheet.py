@@ -57,6 +57,10 @@ VIEWS = ("front", "back", "closeup")
 POSES = ("rest", "walk")
 BACKDROP = (124, 127, 133)  # sRGB grey behind the rows (the world light's colour, darker)
 CROWN = 1.8  # close-ups: every crown put at this height (m), so one camera frames all heads
+# The frame spans this many body spacings more than the bodies: the A-pose arms of the
+# tallest bodies at the ends (up to ~1.1 m) reach past their 0.8 m slot, and the camera looks
+# on from a little to the side, so the last body's arm was cut at the frame's edge.
+MARGIN = 0.4
 
 
 @dataclass(frozen=True)
@@ -144,7 +148,7 @@ def row_size(view: str, count: int, width: int) -> tuple[int, int]:
     """(W, H) pixels of a row render: ``width`` wide (close-ups twice, to zoom in on)."""
     f = FRAMINGS["closeup" if view == "closeup" else "full"]
     w = width * 2 if view == "closeup" else width
-    return w, max(8, round(w * f.height / (f.spacing * count)))
+    return w, max(8, round(w * f.height / (f.spacing * (count + MARGIN))))
 
 
 def render_row(humans, view: str, pose: str, path: Path, width: int, samples: int) -> Path:
@@ -176,7 +180,8 @@ def _aim(f: Framing, count: int, size: tuple[int, int]) -> None:
 
     back = np.asarray(f.direction, float)
     back /= np.linalg.norm(back)
-    distance = f.spacing * count / 2 * 85.0 / 18.0  # half the 36 mm sensor spans half the row
+    # half the 36 mm sensor spans half the row and its margin
+    distance = f.spacing * (count + MARGIN) / 2 * 85.0 / 18.0
     centre = np.array([0.0, 0.0, f.middle])
     add_camera(CameraModel(85.0, 36.0, 24.0, "HORIZONTAL", 0.0, 0.0, size, 100, (1.0, 1.0),
                            look_at(centre + back * distance, centre)))  # fmt: skip
