@@ -79,6 +79,7 @@ def cut(
     ease,
     relax: int = 0,
     loose: bool = False,
+    sided: bool = False,
 ) -> Mesh:
     """A surface of the chosen faces, pushed ``ease`` metres out along the skin normal.
 
@@ -88,6 +89,8 @@ def cut(
     staircase of whole faces.
     loose: ease along the source surface's own normal (``surface_normals``, for a surface
     standing off the body such as ``helper-skirt``), else along the skin's.
+    sided: every move kept to its side of the body's midplane (``on_their_side``), for cloth
+    that spans the cleft of the buttocks (a loose top) rather than following it.
     Returns a Mesh (own vertex numbering) with box-projected UVs; faces face outward.
     """
     chosen = faces[keep]
@@ -96,11 +99,12 @@ def cut(
     local = inverse.reshape(chosen.shape).astype(np.int32)
     normals = surface_normals(body, faces)[used] if loose else body.outward(points)
     if relax:
-        points = relax_boundary(points, local, normals, relax)
+        points = relax_boundary(points, local, normals, relax, sided)
     if callable(ease):
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
-    points = points + on_their_side(points, np.asarray(ease)[..., None] * normals)
+    moves = np.asarray(ease)[..., None] * normals
+    points = points + (on_their_side(points, moves) if sided else moves)
     ridge = float(body.marks.shoulder[:, 1].mean())
     mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local), ridge_y=ridge)
     return with_limb_uvs(mesh, body.part[used], body.marks)
@@ -151,7 +155,7 @@ def surface_normals(body: AuthoringBody, faces: np.ndarray) -> np.ndarray:
 
 
 def relax_boundary(
-    points: np.ndarray, faces: np.ndarray, normals: np.ndarray, passes: int
+    points: np.ndarray, faces: np.ndarray, normals: np.ndarray, passes: int, sided: bool = False
 ) -> np.ndarray:
     """(N, 3) points with the open edges of a cut smoothed into curves.
 
@@ -159,7 +163,8 @@ def relax_boundary(
     itself (Taubin's shrink-free lambda/mu pair), then lets the next ring of vertices settle
     between their neighbours so the border faces keep their shape; every move stays in the
     surface's tangent plane at the vertex's original position (normals (N, 3)).
-    Vertices where two loops touch stay put.
+    Vertices where two loops touch stay put. ``sided``: moves kept to their side of the
+    body's midplane (``on_their_side``).
     """
     edges, _ = boundary_edges(faces)
     count = len(points)
@@ -178,8 +183,9 @@ def relax_boundary(
     def settle(moved: np.ndarray, which: np.ndarray) -> None:
         step = moved - origin[which]
         step -= np.einsum("nd,nd->n", step, n[which])[:, None] * n[which]
-        # A hem across a cleft: the walls' tangent planes slid its vertices past each other.
-        p[which] = origin[which] + on_their_side(origin[which], step, keep_length=False)
+        if sided:  # a hem across a cleft: the walls' tangent planes slid it past itself
+            step = on_their_side(origin[which], step, keep_length=False)
+        p[which] = origin[which] + step
 
     for _ in range(passes):
         for weight in (0.5, -0.53):

@@ -64,7 +64,8 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
     ``bridge``: loose cloth spanning the body's hollows (``bridged``)."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
-    mesh = level_hems(cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX))
+    mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX, sided=bridge)
+    mesh = level_hems(mesh)
     if bridge:
         mesh = bridged(body, mesh)
     if snug is not None:
