@@ -716,3 +716,47 @@ def test_loose_tops_span_the_cleft_without_folding_into_it(name, params):
     middle = seat[faces].all(axis=1) & (np.abs(q[:, :, 0]).max(axis=1) < 0.03)
     fold = _fold_angles(v, faces, middle & (area / longest > 0.004))
     assert fold.max() < 45, fold.max()
+
+
+# ---------------------------------------------------------------------------- skirt front
+
+HEAVY_WOMAN = {"gender": 0.0, "age": 0.6, "weight": 1.0}
+
+
+@pytest.mark.parametrize("params", [HEAVY_WOMAN, {"gender": 0.0, "age": 0.3}])
+def test_skirt_front_follows_both_legs_alike_across_the_midline(params):
+    """The skirt is bound to a vertex, its mirror image and the pelvis so it swings as one
+    (``tailoring.blend_sides``); with the mirror weighing 0.5 at the midline beside the
+    pelvis' 0.5, a vertex just off the midline followed the other leg more than its own,
+    the two halves of the front crossing mid-stride (a dark notch between the legs). Each
+    vertex within 15 cm of the midline weighs its own leg at least as much as the other,
+    and skinned a quarter and three quarters into the walk the front's midline lies no
+    more than 3 mm behind its left and right neighbours."""
+    from avatar.clothes.authoring import AuthoringBody
+    from avatar.clothes.fitting import garment_weights
+
+    human = Human(params).dressed("dress")
+    garment = human.outfit.garments[0].garment
+    rest = human.outfit.garments[0].mesh.vertices[: len(garment.mesh.vertices)]
+    w = garment_weights(garment, human.weights, human.skeleton.names)
+    names = human.skeleton.names
+    marks = AuthoringBody(human.body).marks
+    skirt = (rest[:, 2] < marks.hip[:, 2].mean() - 0.05) & (np.abs(rest[:, 0]) < 0.15)
+    leg = {}
+    for tag in ("L", "R"):
+        bones = [names.index(f"upperleg01.{tag}"), names.index(f"upperleg02.{tag}")]
+        leg[tag] = np.where(np.isin(w.indices, bones), w.weights, 0).sum(axis=1)
+    own = np.where(rest[:, 0] > 0, leg["L"] - leg["R"], leg["R"] - leg["L"])  # left is +x
+    assert own[skirt & (np.abs(rest[:, 0]) > 0.005)].min() > -0.005
+    left, right = _side_neighbours(rest.astype(np.float64), garment.mesh.faces)
+    front = skirt & (rest[:, 1] < marks.hip[0, 1]) & (np.abs(rest[:, 0]) < 0.004)
+    front &= (left != right) & (rest[:, 2] > marks.knee[0, 2] - 0.1)
+    assert front.sum() >= 5
+    walk = human.walk(seconds=1.0, fps=24)
+    for frame in (6, 18):
+        world = kinematics.forward(human.skeleton, walk.rotations[frame:frame + 1],
+                                   walk.translations[frame:frame + 1])  # fmt: skip
+        matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
+        v = skinning.linear_blend(rest, w, matrices).astype(np.float64)
+        behind = v[:, 1] - (v[left, 1] + v[right, 1]) / 2
+        assert behind[front].max() < 0.003, (frame, behind[front].max())

@@ -591,10 +591,11 @@ def blend_sides(body: AuthoringBody, piece: Piece, group: str, pelvis: float = 0
                 reach: float = 0.18) -> Piece:  # fmt: skip
     """A skirt that swings as one: each vertex re-bound to its dominant reference, that
     reference's mirror image across the body's midline and a vertex of the skirt's top at
-    the same angle, with weights (1 - m - pelvis, m, pelvis), m = 0.5 at the midline and 0
-    ``reach`` m out to the side. The offsets absorb the change, so the skirt sits exactly
-    where it was on the authoring body; skin weights transferred through the binding then
-    mix both legs and the hips, so the front does not split with the legs in a stride.
+    the same angle, with weights (1 - m - pelvis, m, pelvis), m = (1 - pelvis) / 2 at the
+    midline (the two legs alike) and 0 ``reach`` m out to the side. The offsets absorb the
+    change, so the skirt sits exactly where it was on the authoring body; skin weights
+    transferred through the binding then mix both legs and the hips, so the front does not
+    split with the legs in a stride.
     ``group``: the helper group the piece is bound to."""
     from scipy.spatial import cKDTree
 
@@ -612,7 +613,11 @@ def blend_sides(body: AuthoringBody, piece: Piece, group: str, pelvis: float = 0
     nearest = np.argmin(np.abs(np.angle(np.exp(1j * (angle[:, None] - ring_angle[None])))),
                         axis=1)  # fmt: skip
     top = ring[nearest]
-    m = 0.5 * np.clip(1 - np.abs(x[dominant, 0]) / reach, 0, 1)
+    # Half of what the pelvis leaves at the midline, so both legs weigh the same there:
+    # with m = 0.5 beside pelvis = 0.5 a vertex just left of the midline followed the right
+    # leg alone and its neighbour just right of it the left leg, the front crossing itself
+    # mid-stride (a 14-33 mm deep dark notch between the legs).
+    m = 0.5 * (1 - pelvis) * np.clip(1 - np.abs(x[dominant, 0]) / reach, 0, 1)
     weights = np.stack([1 - m - pelvis, m, np.full(len(m), pelvis)], 1)
     indices = np.stack([dominant, mirror, top], 1).astype(np.int32)
     position = piece.mesh.vertices.astype(np.float64)
