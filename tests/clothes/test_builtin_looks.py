@@ -197,6 +197,17 @@ def test_shoe_material_is_an_atlas_of_leather_sole_and_cord():
     assert sole.mean() < laces.mean() and sole.max() < 60
 
 
+@pytest.mark.parametrize("name", ["leggings", "swimsuit"])
+def test_stretch_knit_has_a_satin_sheen_not_a_latex_gloss(name):
+    """Lycra's roughness map (what every renderer reads) sits between a gloss and cotton:
+    at 0.35 black leggings rendered as latex, with mirror streaks down the shins."""
+    def roughness(spec_name: str) -> float:
+        m = builtin.build(builtin.BY_NAME[spec_name], library.authoring_body(), 256).material
+        return float(np.asarray(m.roughness_texture, dtype=float).mean() / 255.0)
+
+    assert 0.5 <= roughness(name) < roughness("tshirt") - 0.1
+
+
 def _bumpiness(mesh, keep: np.ndarray) -> float:
     """Mean distance of the kept vertices from the average of their mesh neighbours."""
     a, b = mesh.faces.ravel(), np.roll(mesh.faces, -1, axis=1).ravel()

@@ -59,7 +59,9 @@ FABRICS = {
     # shallow, so it reads as leather rather than crinkled wet plastic with glittery specks.
     "leather": Fabric("leather", "grain", 40, 0.35, 0.62, 0.05, rough_weave=0.09),
     "canvas": Fabric("canvas", "plain", 70, 1.8, 0.9, 0.2),
-    "lycra": Fabric("lycra", "knit", 160, 0.6, 0.35, 0.06),
+    # Stretch knit (leggings, swimsuits): a soft satin sheen, not a gloss; at 0.35 black
+    # leggings read as latex, with mirror-like streaks down the shins.
+    "lycra": Fabric("lycra", "knit", 160, 0.6, 0.55, 0.06),
     "wool": Fabric("wool", "twill", 60, 2.2, 0.95, 0.25),
     "hair": Fabric("hair", "strands", 220, 2.5, 0.5, 0.6),
     "rubber": Fabric("rubber", "grain", 90, 0.8, 0.75, 0.05),
