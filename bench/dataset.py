@@ -67,9 +67,11 @@ def bare_vs_labelled(args, folder: Path) -> tuple[float, float, float]:
     return bare.mean(), labelled.mean(), float(np.median(labelled / bare))
 
 
-def rate(args, workers: int, engine: str, folder: Path, threads: int | None = None) -> float:
-    """Samples/s of a fresh run; ``threads``: each local worker's Cycles threads (default:
-    the runner's share of the cores)."""
+def rate(args, workers: int, engine: str, folder: Path,
+         threads: int | None = None) -> tuple[float, float]:  # fmt: skip
+    """(samples/s of a fresh run end to end, its steady samples/s once each worker's first
+    sample, which carries its start-up, is in: ``RunReport.steady_rate``); ``threads``: each
+    local worker's Cycles threads (default: the runner's share of the cores)."""
     c = _config(args, args.count)
     shares = runner.render_threads
     cores = os.sched_getaffinity(0)
@@ -87,7 +89,7 @@ def rate(args, workers: int, engine: str, folder: Path, threads: int | None = No
         runner.render_threads = shares  # type: ignore[assignment]
         os.sched_setaffinity(0, cores)
     assert not report.failed, report.failed
-    return args.count / (time.perf_counter() - start)
+    return args.count / (time.perf_counter() - start), report.steady_rate(workers)
 
 
 def _spin(core: int) -> float:
@@ -175,23 +177,25 @@ def _throughput(args, root: Path) -> None:
     share = max(1, (os.cpu_count() or 1) // 2)
     rounds = []
     for r in range(args.repeat):
-        one_share = rate(args, 1, "local", root / "w1s", threads=share)
-        one = rate(args, 1, "local", root / "w1")
-        two = rate(args, 2, "local", root / "w2")
+        one_share, steady_one = rate(args, 1, "local", root / "w1s", threads=share)
+        one, _ = rate(args, 1, "local", root / "w1")
+        two, steady_two = rate(args, 2, "local", root / "w2")
         ceiling = machine_ceiling()
-        rounds.append((two / (2 * one_share), ceiling, two / one))
+        rounds.append((two / (2 * one_share), steady_two / (2 * steady_one), ceiling, two / one))
         print(f"round {r + 1}: local engine: 1 worker on {share} thread(s) {one_share:.3f} "
               f"samples/s, 2 workers on {share} each {two:.3f} samples/s: efficiency "
-              f"{rounds[-1][0]:.2f}; 1 worker on every core {one:.3f} samples/s: 2 workers "
-              f"{rounds[-1][2]:.2f}x that; machine ceiling (anchor): two CPU-bound loops on "
-              f"two cores each run at {ceiling:.2f} of one alone", flush=True)  # fmt: skip
-    efficiency, ceiling, speedup = np.median(np.array(rounds), axis=0)
-    print(f"median of {len(rounds)} round(s): efficiency {efficiency:.2f} (goal >= 0.85), "
-          f"machine ceiling {ceiling:.2f}, 2 workers {speedup:.2f}x 1 worker on every core; "
-          f"efficiency / ceiling per round "
-          f"{', '.join(f'{e / c:.2f}' for e, c, _ in rounds)}")  # fmt: skip
+              f"{rounds[-1][0]:.2f} end to end, {rounds[-1][1]:.2f} steady (after each "
+              f"worker's first sample: {steady_one:.3f} and {steady_two:.3f} samples/s); 1 "
+              f"worker on every core {one:.3f} samples/s: 2 workers {rounds[-1][3]:.2f}x "
+              f"that; machine ceiling (anchor): two CPU-bound loops on two cores each run at "
+              f"{ceiling:.2f} of one alone", flush=True)  # fmt: skip
+    efficiency, steady, ceiling, speedup = np.median(np.array(rounds), axis=0)
+    print(f"median of {len(rounds)} round(s): efficiency {efficiency:.2f} end to end, "
+          f"{steady:.2f} steady (goal >= 0.85), machine ceiling {ceiling:.2f}, 2 workers "
+          f"{speedup:.2f}x 1 worker on every core; steady efficiency / ceiling per round "
+          f"{', '.join(f'{e / c:.2f}' for _, e, c, _ in rounds)}")  # fmt: skip
     if not args.skip_ray:
-        ray = rate(args, 2, "ray", root / "ray")
+        ray, _ = rate(args, 2, "ray", root / "ray")
         print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
               f"{ray / two:.2f}x the local engine")  # fmt: skip
 

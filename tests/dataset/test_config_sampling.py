@@ -154,3 +154,15 @@ def test_population_mode_draws_realistic_statures(model):
     assert population.stature_of(model, base | {"height": h}) == pytest.approx(1.83, abs=1e-3)
     c = config.loads(config.EXAMPLE.replace('mode = "uniform"', 'mode = "population"'))
     assert _key(sampling.sample(c, 4)) == _key(sampling.sample(c, 4))
+
+
+def test_steady_rate_leaves_out_the_workers_start_up():
+    """Two workers: the first two samples carry the workers' start-up; the rate after them
+    is the steady one (millions of samples pay the start-up once)."""
+    from avatar.dataset.runner import RunReport
+
+    report = RunReport(rendered=6, finished_at=[9.0, 9.5, 11.0, 12.0, 13.5, 14.5])
+    assert report.steady_rate(2) == pytest.approx(4 / 5.0)
+    assert report.steady_rate(0) == report.steady_rate(1) == pytest.approx(5 / 5.5)
+    assert RunReport(finished_at=[3.0]).steady_rate(1) == 0.0
+    assert RunReport(finished_at=[1.0, 2.0]).steady_rate(5) == 0.0

@@ -55,6 +55,10 @@ def dataset(tmp_path_factory, model):
     c = config.load(out.parent / "ds.toml")
     report = runner.run(c, out / "set", workers=1, config_text=CONFIG)
     assert report.rendered == 3 and not report.failed, report.failed
+    # when each sample came in: rising, within the run (the steady rate is timed on them)
+    times = report.finished_at
+    assert len(times) == 3 and 0 < times[0] < times[1] < times[2] <= report.seconds
+    assert report.steady_rate(1) == pytest.approx(2 / (times[2] - times[0]))
     return c, out / "set"
 
 

@@ -33,12 +33,24 @@ CATEGORIES = [{"id": 1, "name": "person", "supercategory": "person",
 
 @dataclass
 class RunReport:
-    """What a run did: samples rendered now, already there, failed (index -> message)."""
+    """What a run did: samples rendered now, already there, failed (index -> message),
+    its seconds, and when each rendered sample came in (seconds from the start, in order:
+    the steady rate, once the workers' start-up is behind them, is what millions of
+    samples cost)."""
 
     rendered: int = 0
     skipped: int = 0
     failed: dict[int, str] = field(default_factory=dict)
     seconds: float = 0.0
+    finished_at: list[float] = field(default_factory=list)
+
+    def steady_rate(self, skip: int) -> float:
+        """Samples/s between the ``skip``-th rendered sample and the last (0 when fewer
+        than two are left to time)."""
+        times = self.finished_at[max(skip, 1) - 1 :]
+        if len(times) < 2 or times[-1] <= times[0]:
+            return 0.0
+        return (len(times) - 1) / (times[-1] - times[0])
 
 
 def run(config: Config, out: str | os.PathLike[str], workers: int = 1, engine: str = "local",
@@ -64,7 +76,7 @@ def run(config: Config, out: str | os.PathLike[str], workers: int = 1, engine: s
             results = _local(config, out, todo, workers)
         else:
             raise AvatarError(f"unknown engine {engine!r}; use local or ray")
-        _collect(out, results, report, len(todo), progress)
+        _collect(out, results, report, len(todo), progress, start)
     report.seconds = time.perf_counter() - start
     finished = store.done(out)
     ids = sorted(i for i in finished if i < config.count)
@@ -229,7 +241,7 @@ def _render_one(config: Config, index: int, out: str, threads: int = 0) -> Resul
 
 
 def _collect(out: Path, results: Iterable[Result], report: RunReport, total: int,
-             progress: bool) -> None:  # fmt: skip
+             progress: bool, start: float) -> None:  # fmt: skip
     from tqdm import tqdm
 
     with tqdm(total=total, unit="sample", disable=not progress, file=sys.stderr) as bar:
@@ -237,6 +249,7 @@ def _collect(out: Path, results: Iterable[Result], report: RunReport, total: int
             if entry is not None:
                 store.append(out, entry)
                 report.rendered += 1
+                report.finished_at.append(time.perf_counter() - start)
             else:
                 report.failed[index] = error or "failed"
                 log.error("sample %d: %s", index, error)
