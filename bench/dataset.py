@@ -101,10 +101,23 @@ def _spin(core: int) -> float:
     return time.perf_counter() - start
 
 
-def machine_ceiling(repeat: int = 3) -> float:
+def _stream(core: int) -> float:
+    """Seconds of a fixed memory-bound loop on one core: numpy sums over arrays far larger
+    than the caches (what a renderer's BVH and image buffers ask of the memory)."""
+    os.sched_setaffinity(0, {core})
+    a, b = np.ones(8_000_000), np.ones(8_000_000)
+    out = np.empty_like(a)
+    start = time.perf_counter()
+    for _ in range(60):
+        np.add(a, b, out=out)
+    return time.perf_counter() - start
+
+
+def machine_ceiling(repeat: int = 3, work=_spin) -> float:
     """What this machine gives two busy processes: the rate of each of two loops on two
     cores at once over one loop alone (1.0 on two real cores; less where the cores share a
-    physical core or the host throttles). The workers' efficiency cannot exceed it."""
+    physical core, the memory bus, or the host throttles). ``work``: ``_spin`` (CPU-bound)
+    or ``_stream`` (memory-bound). The workers' efficiency cannot exceed it."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
@@ -112,8 +125,8 @@ def machine_ceiling(repeat: int = 3) -> float:
     ratios = []
     with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
         for _ in range(repeat):
-            alone = pool.submit(_spin, cores[0]).result()
-            both = [f.result() for f in [pool.submit(_spin, c) for c in cores]]
+            alone = pool.submit(work, cores[0]).result()
+            both = [f.result() for f in [pool.submit(work, c) for c in cores]]
             ratios.append(alone / max(both))
     return sorted(ratios)[len(ratios) // 2]
 
@@ -180,20 +193,23 @@ def _throughput(args, root: Path) -> None:
         one_share, steady_one = rate(args, 1, "local", root / "w1s", threads=share)
         one, _ = rate(args, 1, "local", root / "w1")
         two, steady_two = rate(args, 2, "local", root / "w2")
-        ceiling = machine_ceiling()
-        rounds.append((two / (2 * one_share), steady_two / (2 * steady_one), ceiling, two / one))
+        ceiling, memory = machine_ceiling(), machine_ceiling(work=_stream)
+        rounds.append((two / (2 * one_share), steady_two / (2 * steady_one), ceiling, two / one,
+                       memory))  # fmt: skip
         print(f"round {r + 1}: local engine: 1 worker on {share} thread(s) {one_share:.3f} "
               f"samples/s, 2 workers on {share} each {two:.3f} samples/s: efficiency "
               f"{rounds[-1][0]:.2f} end to end, {rounds[-1][1]:.2f} steady (after each "
               f"worker's first sample: {steady_one:.3f} and {steady_two:.3f} samples/s); 1 "
               f"worker on every core {one:.3f} samples/s: 2 workers {rounds[-1][3]:.2f}x "
-              f"that; machine ceiling (anchor): two CPU-bound loops on two cores each run at "
-              f"{ceiling:.2f} of one alone", flush=True)  # fmt: skip
-    efficiency, steady, ceiling, speedup = np.median(np.array(rounds), axis=0)
+              f"that; machine ceiling (anchors): two CPU-bound loops on two cores each run at "
+              f"{ceiling:.2f} of one alone, two memory-bound ones at {memory:.2f}",
+              flush=True)  # fmt: skip
+    efficiency, steady, ceiling, speedup, memory = np.median(np.array(rounds), axis=0)
     print(f"median of {len(rounds)} round(s): efficiency {efficiency:.2f} end to end, "
-          f"{steady:.2f} steady (goal >= 0.85), machine ceiling {ceiling:.2f}, 2 workers "
-          f"{speedup:.2f}x 1 worker on every core; steady efficiency / ceiling per round "
-          f"{', '.join(f'{e / c:.2f}' for _, e, c, _ in rounds)}")  # fmt: skip
+          f"{steady:.2f} steady (goal >= 0.85), machine ceiling {ceiling:.2f} CPU-bound, "
+          f"{memory:.2f} memory-bound, 2 workers {speedup:.2f}x 1 worker on every core; "
+          f"steady efficiency / CPU ceiling per round "
+          f"{', '.join(f'{e / c:.2f}' for _, e, c, _, _ in rounds)}")  # fmt: skip
     if not args.skip_ray:
         ray, _ = rate(args, 2, "ray", root / "ray")
         print(f"ray engine (local cluster, 2 CPUs): {ray:.3f} samples/s = "
