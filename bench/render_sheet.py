@@ -60,7 +60,7 @@ CROWN = 1.8  # close-ups: every crown put at this height (m), so one camera fram
 # The frame spans this many body spacings more than the bodies: the A-pose arms of the
 # tallest bodies at the ends (up to ~1.1 m) reach past their 0.8 m slot, and the camera looks
 # on from a little to the side, so the last body's arm was cut at the frame's edge.
-MARGIN = 0.4
+MARGIN = 0.8
 
 
 @dataclass(frozen=True)
