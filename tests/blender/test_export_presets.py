@@ -230,7 +230,9 @@ def test_reimport(walker, preset, fmt):
             assert image.size[0] > 0
             pixels = np.empty(image.size[0] * image.size[1] * 4, np.float32)
             image.pixels.foreach_get(pixels)
-            assert pixels.reshape(-1, 4)[:, :3].std() > 0.01, f"{name}: a flat image"
+            # A lost texture is one flat colour (std 0); a white cotton tee's colour varies
+            # little (~0.006: its weave is in the normal map since the band-limited cotton).
+            assert pixels.reshape(-1, 4)[:, :3].std() > 0.003, f"{name}: a flat image"
         keys = obj.data.shape_keys
         got = [k.name for k in keys.key_blocks[1:]] if keys else []
         assert got == expect["keys"].get(name, []), name
