@@ -17,8 +17,11 @@ demo: setup
 	@echo "wrote $(OUT)/demo.glb and $(OUT)/demo.png"
 
 # The tests start with the style checks (lint): any ruff or mypy finding fails `make test`.
+# The video tests run again in .venv-mocap, where MediaPipe is installed (see setup.sh).
 test: lint
 	$(VENV)/python -m pytest -q -x --timeout=900
+	if [ -x .venv-mocap/bin/python ]; then \
+		.venv-mocap/bin/python -m pytest -q -x --timeout=900 -p no:cacheprovider tests/mocap/test_video.py; fi
 
 # ruff (rules in pyproject.toml: layering bans bpy outside avatar.blender, no print in the
 # library) and mypy (src/avatar, configured in pyproject.toml).

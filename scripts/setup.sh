@@ -30,6 +30,24 @@ if [ ! -f "$STAMP" ]; then
   rm -f .venv/.avatar-setup-* && touch "$STAMP"
 fi
 
+# The mocap extra (MediaPipe Pose, OpenCV) in its own .venv-mocap: mediapipe 0.10.14 pins
+# protobuf < 5, which Ray's dependencies reject. It sees .venv's packages after its own (a
+# .pth), so the video tests run there against the same Avatar and bpy. Optional: without it
+# the video tests skip.
+MOCAP_STAMP=.venv-mocap/.avatar-setup-$(sha1sum pyproject.toml scripts/setup.sh | sha1sum | cut -c1-12)
+if [ ! -f "$MOCAP_STAMP" ]; then
+  if { [ -x .venv-mocap/bin/python ] || "$PY" -m venv .venv-mocap; } \
+    && .venv-mocap/bin/python -m pip install -q mediapipe==0.10.14 \
+      'opencv-python-headless>=4.8,<4.12' "numpy==$(.venv/bin/python -c 'import numpy; print(numpy.__version__)')"; then
+    main_site=$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+    mocap_site=$(.venv-mocap/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+    echo "import site; site.addsitedir('$main_site')" > "$mocap_site/zz_avatar_main_venv.pth"
+    rm -f .venv-mocap/.avatar-setup-* && touch "$MOCAP_STAMP"
+  else
+    echo "setup: the mocap extra could not be installed in .venv-mocap; the video tests will skip" >&2
+  fi
+fi
+
 # The Khronos glTF validator, for tests; optional when npm is absent.
 if command -v npm >/dev/null && [ ! -d .cache/node/node_modules/gltf-validator ]; then
   mkdir -p .cache/node
