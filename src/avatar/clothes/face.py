@@ -1,6 +1,7 @@
 """Face pieces: eyebrows painted on patches of the brow skin, eyelashes on the base mesh's
 lash helper strips (textures in ``textures``: ``brow_alpha``, ``lash_alpha``), facial hair
-(a short beard and a moustache as strand cards, stubble as a tiled layer on the skin), and
+(a short beard as strand cards over a dense undercoat, a moustache as strand cards, stubble
+as a tiled layer on the skin), and
 the UVs of the teeth over their teeth-and-gums texture."""
 
 from __future__ import annotations
@@ -308,16 +309,49 @@ def _beard_flow(centre: np.ndarray):
     return flow
 
 
-def beard(body: AuthoringBody, count: int = 2400, length=(0.007, 0.013)) -> Piece:
-    """A short full beard: narrow strand cards rooted where ``facial_hair_density(body,
-    "beard", ...)`` lets them grow, combed down the face, about a centimetre long, lying
-    close to the skin, thinning out (sparser, shorter, flatter) over the last centimetre to
-    its edges. The hair above the mouth (the moustache) and the rest are bound apart: one
+def beard(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:
+    """A short full beard: a dense undercoat of hair on the skin where it grows
+    (``beard_undercoat``) under strand cards combed down the face (``beard_cards``).
+
+    Cards alone, however many, left skin showing between them: 2,400 cards 4.4 mm wide
+    with two in five of their texture's hairs kept covered some 70 % of the chin and
+    cheeks, and the rest read as skin blotches (a grey beard on pale skin most). 2,200
+    cards (8,800 vertices) over a 780-vertex undercoat stay under 10,000 vertices."""
+    return join([beard_undercoat(body), beard_cards(body, count, length)])
+
+
+BEARD_UNDERCOAT_EASE_M = 0.0006  # off the skin (stubble lies at 0.5 mm, under it)
+UNDERCOAT_TILE_M = 0.04  # m of skin round the face across the hair texture's width
+
+
+def beard_undercoat(body: AuthoringBody) -> Piece:
+    """The beard's skin lifted 0.6 mm, mapped onto the undercoat rows of the beard
+    material (``looks.facial_hair.beard_material``): u the arc round the face (in
+    ``UNDERCOAT_TILE_M`` a texture width, so hairs keep their size), v from how thickly
+    the beard grows there (``facial_hair_density`` -> ``facial_hair.undercoat_v``): fully
+    covered well inside, thinning out to bare skin over the beard's soft edges."""
+    from avatar.looks import facial_hair as fh
+
+    faces = body.skin_faces
+    mesh = cut(body, faces, facial_hair_mask(body, "beard"), BEARD_UNDERCOAT_EASE_M, relax=4)
+    centre, *_ = mouth_frame(body)
+    p = mesh.vertices.astype(np.float64)
+    angle = np.arctan2(p[:, 0], -(p[:, 1] - centre[1]))
+    u = angle * fh.ARC_RADIUS_M / UNDERCOAT_TILE_M
+    v = fh.undercoat_v(facial_hair_density(body, "beard", p))
+    uv = np.stack([u, v], -1)[mesh.faces].reshape(-1, 2)
+    return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
+
+
+def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:
+    """A short beard's strand cards rooted where ``facial_hair_density(body, "beard",
+    ...)`` lets them grow, combed down the face, about a centimetre long, lying close to
+    the skin, thinning out (sparser, shorter, flatter) over the last centimetre to its
+    edges. The hair above the mouth (the moustache) and the rest are bound apart: one
     rides the upper lip, the other the jaw, so opening the mouth parts them.
 
     One segment a card (4 vertices: a centimetre-long card bends over the jaw by a tenth
-    of a millimetre between its ends) and 2,400 cards 4.4 mm wide, which cover the face
-    as 3,600 cards 3.2 mm wide of two segments did: 9,600 vertices instead of 21,600."""
+    of a millimetre between its ends)."""
     centre, mouth, *_ = mouth_frame(body)
     keep = facial_hair_mask(body, "beard")
     c = body.vertices[body.skin_faces].mean(axis=1)

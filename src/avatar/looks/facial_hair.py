@@ -71,13 +71,28 @@ def grey_share(age: float) -> float:
     return float(GREY_MOST * t**0.8)
 
 
+# A beard's undercoat (``clothes.face.beard_undercoat``) runs over the dense rows of the
+# hair layout (v in [0.5, 1]): its hairs cover none of the skin at v = UNDERCOAT_V[0] and
+# all of it from UNDERCOAT_V[1] up.
+UNDERCOAT_V = (0.52, 0.9)
+
+
+def undercoat_v(density: np.ndarray) -> np.ndarray:
+    """(N,) the undercoat's v for a beard's density (0..1) there (``UNDERCOAT_V``)."""
+    low, high = UNDERCOAT_V
+    return low + (high - low) * np.clip(np.asarray(density, np.float64), 0, 1)
+
+
 def beard_material(spec, size: int = 1024) -> Material:
     """A beard's or moustache's cut-out strand material in the spec's hair colour (the
-    scalp hair's, ``textures.hair_material``) with its card strands thinned: beard hair is
-    sparse, so only about two hair-wide columns in five are kept and skin shows between
-    them (a card of scalp strands would read as a solid block on the face); and the kept
-    strands end raggedly (each tip at its own length, a fine taper instead of a cut) so the
-    moustache's and beard's outline breaks up into hairs."""
+    scalp hair's, ``textures.hair_material``).
+
+    Strand cards (v in [0, 0.5]) thinned: beard hair is coarse and sparse, so only about
+    two hair-wide columns in five are kept, and the kept strands end raggedly (each tip at
+    its own length, a fine taper instead of a cut) so the outline breaks up into hairs (a
+    card of scalp strands would read as a solid block on the face).
+    The dense rows (v in [0.5, 1]) are the undercoat under a beard's cards: short hairs
+    along v, covering more of the skin the higher v is (``UNDERCOAT_V``)."""
     m = textures.hair_material(spec, size)
     colour = np.array(m.base_color_texture, copy=True)
     rng = np.random.default_rng([size, 17])
@@ -93,7 +108,25 @@ def beard_material(spec, size: int = 1024) -> Material:
     fine = np.convolve(kept.astype(np.float32), np.ones(3) / 3, "same") * 0.35
     cover = np.maximum(kept.astype(np.float32), fine)[None, :] * tip
     colour[cards, :, 3] = np.round(colour[cards, :, 3] * cover).astype(np.uint8)
+    colour[: size - half, :, 3] = undercoat_alpha(size - half, size, hair, rng)
     return replace(m, base_color_texture=colour)
+
+
+def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
+    """(rows, size) uint8 alpha of the undercoat rows (row 0: v = 1): hairs ``hair``
+    texels wide and some 30 rows long, in random order of appearance, so that a row at v
+    shows the share ``(v - UNDERCOAT_V[0]) / (UNDERCOAT_V[1] - UNDERCOAT_V[0])`` of them
+    (a beard thinning out hair by hair at its edge, not fading as a whole)."""
+    cols = size // hair + 1
+    # Each hair's rank (0..1) among its neighbours, varying along its length (v).
+    knots = rng.uniform(size=(rows // 30 + 2, cols))
+    at = np.linspace(0, rows // 30 + 1, rows)
+    rank = np.stack([np.interp(at, np.arange(len(knots)), knots[:, c]) for c in range(cols)], 1)
+    rank = np.repeat(rank, hair, axis=1)[:, :size]
+    v = 1 - (np.arange(rows) + 0.5) / size  # row 0 at the top (v = 1), down to 0.5
+    low, high = UNDERCOAT_V
+    share = np.clip((v - low) / (high - low), 0, 1)[:, None]
+    return np.where(rank < share * 1.02, 255, 0).astype(np.uint8)
 
 
 def stubble_alpha(size: int, seed: int = 0) -> np.ndarray:
