@@ -17,7 +17,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from tests.dataset.test_dataset_render import CONFIG
 
 pytestmark = pytest.mark.skipif(
