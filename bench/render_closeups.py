@@ -78,11 +78,23 @@ SETS["facial"] = [  # moustache, short beard and stubble, young and old, framed 
     ({"gender": 1.0, "age": 0.4}, ("eyebrows", "eyelashes", "hair-buzz", "stubble")),
     ({"gender": 1.0, "age": 0.7, "african": 1.0, "asian": 0.0, "caucasian": 0.0}, ("eyebrows", "eyelashes", "hair-short", "stubble")),  # noqa: E501
 ]  # fmt: skip
+SETS["jacket"] = [  # issue 14's sixth pass: the jacket's construction, man, woman, child
+    ({"gender": 1.0, "age": 0.5}, ("jacket", "tshirt", "jeans")),
+    ({"gender": 0.0, "age": 0.45}, ("jacket", "longsleeve", "trousers")),
+    ({"gender": 1.0, "age": 0.9, "weight": 0.8}, ("jacket", "tshirt", "trousers")),
+]  # fmt: skip
+SETS["shoes6"] = [  # issue 14's sixth pass: shoes, sneakers and boots side by side
+    ({"gender": 1.0, "age": 0.5}, ("socks", "shoes", "jeans")),
+    ({"gender": 0.0, "age": 0.45}, ("socks", "sneakers", "jeans")),
+    ({"gender": 0.3, "age": 0.12}, ("socks", "sneakers", "shorts")),
+    ({"gender": 1.0, "age": 0.5, "weight": 0.7}, ("socks", "boots", "jeans")),
+]  # fmt: skip
 HEAD_SETS = ("heads", "hair", "looks5", "facial")
 CROWN_AIM = 1.8 - 0.32  # tops: crowns put at 1.8 m (as heads), the camera on the shoulders
 # set -> (metres between bodies, frame height / width per body, aim height (m))
 FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM),
-           "facial": (0.22, 1.0, 1.8 - 0.2)}  # fmt: skip
+           "facial": (0.22, 1.0, 1.8 - 0.2), "jacket": (0.75, 1.1, 1.27),
+           "shoes6": (0.42, 0.5, 0.07)}  # fmt: skip
 # Per set: where the camera looks (z of the aim point relative to the aligned height, m),
 # and the views (name -> direction from subject to camera).
 VIEWS = {

@@ -151,7 +151,11 @@ def test_jacket_leather_is_satin_not_glittery_plastic():
     nz = m.normal_texture[..., 2].astype(np.float32) / 127.5 - 1
     assert np.degrees(np.arccos(np.percentile(nz, 5))) < 12  # no crinkle
     normal = m.normal_texture[..., :2].astype(np.float32).mean(-1) / 255
-    assert _high_frequency(normal) < 0.015  # no glitter
+    # No glitter in the leather itself: the median 64 px block (the jacket's seams, zip
+    # teeth and topstitching are sharp on purpose, and sparse).
+    blocks = normal[: normal.shape[0] // 64 * 64, : normal.shape[1] // 64 * 64]
+    blocks = blocks.reshape(normal.shape[0] // 64, 64, -1, 64).swapaxes(1, 2).reshape(-1, 64, 64)
+    assert np.median([_high_frequency(b) for b in blocks]) < 0.015
     rough = m.roughness_texture.astype(np.float32) / 255 * m.roughness
     low, high = np.percentile(rough, [1, 99])
     assert 0.5 <= low and high <= 0.75 and high - low > 0.03  # satin to matte, gently varied

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from avatar.clothes import face, hair, headwear, shoes, tailoring
+from avatar.clothes import face, hair, headwear, jacket, shoes, tailoring
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -653,7 +653,7 @@ SPECS = [
     Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014, bridge=True), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
-    Spec("jacket", "tops", lambda b: _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
+    Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
     Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501

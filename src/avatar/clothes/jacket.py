@@ -1,0 +1,297 @@
+"""A jacket's construction: its surface unrolled into the panels a jacket is sewn from,
+and the seams, zip, pockets, bands and topstitching painted where a tailor puts them.
+
+The jacket's geometry is the open top cut from ``helper-tights`` (``builtin``); this
+module only gives it its own UV layout and a ``tailored.Layout`` (as jeans have), so its
+maps carry the construction at 2K instead of a tiling leather that read as a plain shiny
+blouse. Panels (``tailoring.Panels`` charts, u: metres across, z: metres up):
+
+- four body panels (left/right front, left/right back) unrolled round the body's
+  vertical axis (``tailoring.panel_coordinates``): their shared edges are the side seams,
+  the shoulder seams and the centre-back seam; each front's inner edge is the opening;
+- one panel per sleeve unrolled round the arm's chain (shoulder, elbow, wrist): u the
+  arc from the arm's top towards its front, z the negative distance down the arm; cut
+  (its seam) underneath; where it meets the body panels is the armhole seam.
+
+Two rows in one texture (body panels above, sleeves below) keep ~1.3 px a millimetre at
+2K (one row of charts gave 1.0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from avatar.clothes import tailoring
+from avatar.clothes.authoring import AuthoringBody, Piece
+from avatar.clothes.tailoring import Panel
+from avatar.looks.tailored import Layout, Mark
+from avatar.mesh import Mesh
+
+PANELS = (*tailoring.TROUSER_PANELS,  # left front, left back, right front, right back
+          Panel("left sleeve", 1, False), Panel("right sleeve", -1, False))
+BODY, SLEEVES = (0, 1, 2, 3), (4, 5)
+ZIP_TOOTH = 0.0035  # m between zip teeth
+THREAD = "charcoal"  # topstitching a shade off black leather
+ZIP_METAL = (0.5, 0.5, 0.52)  # nickel zip teeth and pulls (linear RGB)
+
+
+def _unwrapped(angle: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """(F, C) corner angles brought within pi of their face's angle (F,): a face across a
+    chart's cut keeps its corners together instead of spanning the whole chart."""
+    return centre[:, None] + np.mod(angle - centre[:, None] + np.pi, 2 * np.pi) - np.pi
+
+
+class JacketPanels(tailoring.Panels):
+    """``tailoring.Panels`` for a jacket: four body panels in the top row, the two
+    sleeves in the row under it (see the module docstring)."""
+
+    def __init__(self, body: AuthoringBody, mesh: Mesh):
+        self.mesh, self.panels = mesh, PANELS
+        v = mesh.vertices.astype(np.float64)
+        f = mesh.faces
+        centre = v[f].mean(axis=1)
+        corners = v[f]
+        side = np.where(centre[:, 0] >= 0, 1, -1)
+        sleeve = _on_sleeve(body, centre)
+        axis = tailoring.body_axis(body.marks)
+        back = centre[:, 1] > axis(side, centre[:, 2])[:, 1]
+        c = f.shape[1]
+        body_uz = tailoring.panel_coordinates(corners.reshape(-1, 3), np.repeat(side, c),
+                                              np.repeat(back, c), axis).reshape(f.shape + (2,))
+        # Sleeves: the angle round the arm from its top, towards the front.
+        arm_c, _, _ = _arm_angle(body, centre, side)
+        arm, arm_r, down = _arm_angle(body, corners.reshape(-1, 3), np.repeat(side, f.shape[1]))
+        arm = _unwrapped(arm.reshape(f.shape), arm_c)
+        sleeve_uz = np.stack([arm * arm_r.reshape(f.shape), -down.reshape(f.shape)], -1)
+        self.corner_uz = np.where(sleeve[:, None, None], sleeve_uz, body_uz)
+        body_panel = np.where(side > 0, 0, 2) + back
+        self.face_panel = np.where(sleeve, np.where(side > 0, 4, 5), body_panel)
+        self.lo = np.array([self.corner_uz[self.face_panel == k].reshape(-1, 2).min(0)
+                            for k in range(len(PANELS))])  # fmt: skip
+        self.hi = np.array([self.corner_uz[self.face_panel == k].reshape(-1, 2).max(0)
+                            for k in range(len(PANELS))])  # fmt: skip
+        self._lay_out_rows()
+
+    def _lay_out_rows(self) -> None:
+        """Body charts side by side in the top row, sleeves in the row under it."""
+        gap = tailoring.GAP
+        widths = self.hi[:, 0] - self.lo[:, 0] + gap
+        heights = self.hi[:, 1] - self.lo[:, 1] + gap
+        rows = (np.array(BODY), np.array(SLEEVES))
+        row_height = [float(heights[r].max()) for r in rows]
+        self.scale = 1.0 / max(float(widths[rows[0]].sum()), float(widths[rows[1]].sum()),
+                               sum(row_height))  # fmt: skip
+        self.u0 = np.zeros(len(PANELS))
+        self.z_lo = np.zeros(len(PANELS))  # each chart's own vertical offset
+        base = 0.0
+        for r, tall in zip(rows[::-1], row_height[::-1], strict=True):  # sleeves at v = 0
+            starts = np.concatenate([[0], np.cumsum(widths[r])[:-1]])
+            self.u0[r] = self.lo[r, 0] - gap / 2 - starts
+            self.z_lo[r] = self.lo[r, 1] - gap / 2 - base
+            base += tall
+        self.z0 = 0.0
+
+    def uv(self, panel: int, uz: np.ndarray) -> np.ndarray:
+        uz = np.atleast_2d(np.asarray(uz, np.float64))
+        return np.stack([(uz[:, 0] - self.u0[panel]) * self.scale,
+                         (uz[:, 1] - self.z_lo[panel]) * self.scale], -1)  # fmt: skip
+
+    def top(self, panel: int, u: np.ndarray) -> np.ndarray:
+        """(N,) z of a chart's top edge at u (the highest corner within 1.5 cm)."""
+        uz = self.corner_uz[self.face_panel == panel].reshape(-1, 2)
+        out = np.empty(len(u))
+        for i, x in enumerate(np.atleast_1d(u)):
+            near = np.abs(uz[:, 0] - x) < 0.015
+            out[i] = uz[near, 1].max() if near.any() else self.hi[panel, 1]
+        return out
+
+
+def _on_sleeve(body: AuthoringBody, centre: np.ndarray) -> np.ndarray:
+    """(F,) bool: faces of a sleeve: past the plane through the shoulder joint across the
+    upper arm, within ARMHOLE_RADIUS of the arm's chain (the armhole). The skin's part
+    labels follow the bones' weights: the shoulder blades count as arm."""
+    side = np.where(centre[:, 0] >= 0, 1, -1)
+    down, radial, _ = _arm_frame(body, centre, side)
+    return (down > 0.0) & (np.linalg.norm(radial, axis=1) < ARMHOLE_RADIUS)
+
+
+ARMHOLE_RADIUS = 0.085  # m round the arm's chain a sleeve reaches (the armpit lies further)
+
+
+def _arm_frame(body: AuthoringBody, points: np.ndarray, side: np.ndarray):
+    """(distance down the arm (N,), radial offset (N, 3), axis direction (N, 3)) of points
+    from their own arm's chain (shoulder, elbow, wrist)."""
+    marks = body.marks
+    down = np.zeros(len(points))
+    radial = np.zeros_like(points)
+    direction = np.zeros_like(points)
+    for s in (0, 1):
+        mine = side == (1 if s == 0 else -1)
+        a, b, c = marks.shoulder[s], marks.elbow[s], marks.wrist[s]
+        p = points[mine]
+        upper_len = np.linalg.norm(b - a)
+        t1 = np.clip((p - a) @ (b - a) / upper_len**2, -0.5, 1.0)
+        t2 = np.clip((p - b) @ (c - b) / np.linalg.norm(c - b) ** 2, 0.0, 1.5)
+        lower = t1 >= 1.0  # past the elbow: on the forearm's segment
+        foot = np.where(lower[:, None], b + t2[:, None] * (c - b), a + t1[:, None] * (b - a))
+        down[mine] = np.where(lower, upper_len + t2 * np.linalg.norm(c - b), t1 * upper_len)
+        d = np.where(lower[:, None], (c - b) / np.linalg.norm(c - b), (b - a) / upper_len)
+        radial[mine] = p - foot
+        direction[mine] = d
+    return down, radial, direction
+
+
+def _arm_angle(body: AuthoringBody, points: np.ndarray, side: np.ndarray):
+    """(angle round the arm from its top, towards the front, in (-pi, pi] (N,), radius
+    (N,), distance down the arm (N,))."""
+    down, radial, d = _arm_frame(body, points, side)
+    up = np.array([0.0, 0.0, 1.0]) - d[:, 2:3] * d
+    up /= np.linalg.norm(up, axis=1, keepdims=True)
+    front = np.cross(d, up) * np.where(side > 0, 1.0, -1.0)[:, None]  # -y on both arms
+    angle = np.arctan2(np.einsum("nd,nd->n", radial, front), np.einsum("nd,nd->n", radial, up))
+    return angle, np.linalg.norm(radial, axis=1), down
+
+
+# ---------------------------------------------------------------------------- marks
+
+
+def _line(panels: JacketPanels, k: int, u, z) -> np.ndarray:
+    u, z = np.broadcast_arrays(np.atleast_1d(u).astype(float), np.atleast_1d(z).astype(float))
+    return panels.uv(k, np.stack([u, z], -1))
+
+
+def _edge(panels: JacketPanels, k: int, z: np.ndarray, outer: bool) -> np.ndarray:
+    return panels.edge(k, np.atleast_1d(z), outer)
+
+
+def _across(panels: JacketPanels, k: int, z: float, inset: float = 0.0) -> np.ndarray:
+    lo = _edge(panels, k, np.array([z]), False)[0] + inset
+    hi = _edge(panels, k, np.array([z]), True)[0] - inset
+    return _line(panels, k, np.linspace(lo, hi, 24), z)
+
+
+def _box(centre: np.ndarray, width: float, height: float, tilt: float) -> np.ndarray:
+    """(4, 2) corners of a ``width`` x ``height`` rectangle round ``centre``, tilted."""
+    c, s = np.cos(tilt), np.sin(tilt)
+    corners = np.array([[-1, 1], [1, 1], [1, -1], [-1, -1]]) * [width / 2, height / 2]
+    return centre + corners @ np.array([[c, s], [-s, c]])
+
+
+def topstitched_seams(panels: JacketPanels, offset: float = 0.005) -> list[Mark]:
+    """The panels' seams (``Panels.seams``) and a row of topstitching ``offset`` m beside
+    each, on the panel's own side (leather seams are pressed open and topstitched)."""
+    seams = panels.seams()
+    if not seams:
+        return []
+    segments = seams[0].points  # (M, 2, 2) uv, both sides of every seam
+    uv_faces = np.concatenate([panels.uv(k, panels.corner_uz[i].mean(0, keepdims=True))
+                               for i, k in enumerate(panels.face_panel)])  # fmt: skip
+    from scipy.spatial import cKDTree
+
+    mid = segments.mean(axis=1)
+    _, inside = cKDTree(uv_faces).query(mid)  # the face each side belongs to
+    along = segments[:, 1] - segments[:, 0]
+    normal = np.stack([-along[:, 1], along[:, 0]], -1)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+    towards = np.sign(np.einsum("md,md->m", uv_faces[inside] - mid, normal))[:, None]
+    shift = (towards * normal * offset * panels.scale)[:, None, :]
+    return [*seams, Mark("stitch", segments + shift, 0.0008)]
+
+
+def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
+    """A zip-front jacket: topstitched side, shoulder, centre-back, armhole and underarm
+    seams; a zip down each front's opening; two lower welt pockets and a chest pocket; a
+    back yoke; a hem band, cuffs and a collar band, each sewn on and topstitched."""
+    out = topstitched_seams(panels)
+    for k in BODY:
+        hem = float(panels.lo[k, 1])
+        band = hem + 0.045  # the hem band's seam
+        out += [Mark("seam", _across(panels, k, band)),
+                Mark("stitch", _across(panels, k, band + 0.005), 0.0008),
+                Mark("stitch", _across(panels, k, hem + 0.008), 0.0008)]  # fmt: skip
+        lo, hi = panels.lo[k, 0], panels.hi[k, 0]
+        u = np.linspace(lo + 0.004, hi - 0.004, 60)
+        top = panels.top(k, u)
+        # The collar band: sewn on 4 cm below the neckline, topstitched both sides; only
+        # where the top edge is the neckline (not over the shoulder, where the sleeve is).
+        neck = top > marks.shoulder[0, 2] + 0.06
+        out += [Mark("seam", _line(panels, k, u[neck], top[neck] - 0.04)),
+                Mark("stitch", _line(panels, k, u[neck], top[neck] - 0.035), 0.0008),
+                Mark("stitch", _line(panels, k, u[neck], top[neck] - 0.007), 0.0008)]
+        inner = lambda z, k=k: _edge(panels, k, np.array([z]), False)[0]  # noqa: E731
+        outer = lambda z, k=k: _edge(panels, k, np.array([z]), True)[0]  # noqa: E731
+        if PANELS[k].back:
+            yoke = marks.chest_z + 0.1
+            out += [Mark("seam", _across(panels, k, yoke)),
+                    Mark("stitch", _across(panels, k, yoke - 0.005), 0.0008)]
+            continue
+        out += _zip(panels, k, band, float(top[0]))
+        # Welt pockets: a raised lip 2.2 cm tall, slanting down towards the side seam.
+        z = band + 0.09
+        centre = np.array([inner(z) + 0.5 * (outer(z) - inner(z)) + 0.01, z])
+        out += _welt(panels, k, centre, 0.14, 0.022, -0.2)
+        if PANELS[k].side > 0:  # the chest pocket, wearer's left
+            z = marks.chest_z + 0.03
+            centre = np.array([inner(z) + 0.075, z])
+            out += _welt(panels, k, centre, 0.1, 0.016, 0.12)
+    elbow = -float(np.linalg.norm(marks.elbow[0] - marks.shoulder[0]))
+    for k in SLEEVES:  # cuffs: a band 5 cm deep at the wrist, topstitched; the underarm seam
+        end = float(panels.lo[k, 1])
+        out += [Mark("seam", _across(panels, k, end + 0.05)),
+                Mark("stitch", _across(panels, k, end + 0.055), 0.0008),
+                Mark("stitch", _across(panels, k, end + 0.008), 0.0008)]  # fmt: skip
+        down = np.linspace(end + 0.01, float(panels.hi[k, 1]) - 0.03, 60)
+        out += [Mark("stitch", _line(panels, k, _edge(panels, k, down, outer) + d, down),
+                     0.0008)
+                for outer, d in ((False, 0.005), (True, -0.005))]  # fmt: skip
+        for j in range(3):  # soft folds in the crook of the elbow (its front)
+            u = np.linspace(0.03, 0.09, 10)
+            out.append(Mark("fold", _line(panels, k, u, elbow + 0.02 * (j - 1)
+                                          + 0.2 * (u - 0.06) ** 2), 0.004, 0.6))  # fmt: skip
+    return out
+
+
+def _zip(panels: JacketPanels, k: int, bottom: float, top: float) -> list[Mark]:
+    """Half a zip along a front's opening: the tape's edge, a row of metal teeth 3 mm in
+    and the tape's topstitching 1.2 cm in; the pull on the wearer's left."""
+    z = np.linspace(bottom - 0.04, top - 0.01, 80)
+    edge = _edge(panels, k, z, False)
+    edge = np.polyval(np.polyfit(z, edge, 3), z)  # one sweep (the faces step)
+    out = [Mark("edge", _line(panels, k, edge + 0.007, z)),
+           Mark("stitch", _line(panels, k, edge + 0.012, z), 0.0008)]
+    teeth = np.arange(z[0], z[-1], ZIP_TOOTH)
+    at = np.interp(teeth, z, edge) + 0.003
+    out += [Mark("rivet", _line(panels, k, u, t), 0.0024) for u, t in zip(at, teeth, strict=True)]
+    if PANELS[k].side > 0:
+        pull = np.array([[at[-1] + 0.002, top - 0.03], [at[-1] + 0.004, top - 0.065]])
+        out.append(Mark("stitch", panels.uv(k, pull), 0.006))
+        out.append(Mark("rivet", panels.uv(k, pull[:1]), 0.009))
+    return out
+
+
+def _welt(panels: JacketPanels, k: int, centre: np.ndarray, width: float, height: float,
+          tilt: float) -> list[Mark]:  # fmt: skip
+    """A welt pocket: a raised lip, its opening's edge along the top, stitched round."""
+    box = _box(centre, width, height, tilt)
+    inset = _box(centre, width - 0.006, height - 0.006, tilt)
+    opening = box[[0, 1]]
+    # The pocket bag under the cloth: a faint outline below the welt.
+    bag = _box(centre - [0, 0.07], width + 0.01, 0.13, tilt)
+    return [Mark("patch", panels.uv(k, box)),
+            Mark("edge", panels.uv(k, opening)),
+            Mark("stitch", panels.uv(k, np.concatenate([inset, inset[:1]])), 0.0008),
+            Mark("fold", panels.uv(k, np.concatenate([bag[1:], bag[:1]])), 0.003, 0.25)]
+
+
+def tailored(body: AuthoringBody, piece: Piece) -> Piece:
+    """The jacket ``piece`` (cut, banded and bound: ``builtin``) with panel UVs and its
+    construction layout; its vertices, faces and binding unchanged."""
+    panels = JacketPanels(body, piece.mesh)
+    layout = Layout(panels.scale, tuple(jacket_marks(panels, body.marks)), THREAD, ZIP_METAL,
+                    extras={"panels": [p.name for p in PANELS]})  # fmt: skip
+    return replace(piece, mesh=panels.textured(), layout=layout)
+
+
+__all__ = ["PANELS", "JacketPanels", "jacket_marks", "tailored", "topstitched_seams"]

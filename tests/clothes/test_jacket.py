@@ -1,0 +1,122 @@
+"""The jacket's construction must show (issue 14): it read as a plain shiny black blouse,
+a tiling leather with no seams, zip, pockets or stitching in its maps.
+
+Checked on the built piece and its maps: panels laid out once in the texture at a
+texel density that holds a stitch, a zip's metal teeth down each front's opening, welt
+pockets on the fronts and seams ridged in the normal map, each landing where a tailor
+puts it on the garment itself (mapped back from the texture to the mesh).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from avatar.clothes import builtin, jacket, library
+from avatar.looks import tailored
+
+
+@pytest.fixture(scope="module")
+def body():
+    return library.authoring_body()
+
+
+@pytest.fixture(scope="module")
+def piece(body):
+    return builtin.BY_NAME["jacket"].make(body)
+
+
+@pytest.fixture(scope="module")
+def maps(piece):
+    return builtin.look(builtin.BY_NAME["jacket"], piece.layout, 512)  # a 1024 px texture
+
+
+def _kinds(piece, kind: str) -> list:
+    return [m for m in piece.layout.marks if m.kind == kind]
+
+
+def _on_mesh(piece, uv: np.ndarray) -> np.ndarray:
+    """(N, 3) the garment points nearest UV points (N, 2): the corner nearest in UV."""
+    mesh = piece.mesh
+    corner_uv = mesh.uvs[mesh.face_uvs.reshape(-1)]
+    corner_v = mesh.vertices[mesh.faces.reshape(-1)]
+    nearest = np.argmin(np.linalg.norm(corner_uv[None] - uv[:, None], axis=2), axis=1)
+    return corner_v[nearest]
+
+
+def _tilt(material) -> np.ndarray:
+    normal = material.normal_texture.astype(float) / 127.5 - 1
+    return np.hypot(normal[..., 0], normal[..., 1])
+
+
+def test_jacket_panels_cover_the_texture_once(body, piece):
+    """Body panels and sleeves each their own chart, apart, inside the texture, at least
+    1.2 texels a millimetre at 2K (a 0.8 mm stitch needs one)."""
+    assert piece.layout is not None and piece.layout.extras["panels"] == [
+        p.name for p in jacket.PANELS]  # fmt: skip
+    panels = jacket.JacketPanels(body, piece.mesh)
+    uv = piece.mesh.uvs.reshape(len(piece.mesh.faces), -1, 2).mean(axis=1)
+    assert piece.mesh.uvs.min() >= 0 and piece.mesh.uvs.max() <= 1
+    boxes = [(uv[panels.face_panel == k].min(0), uv[panels.face_panel == k].max(0))
+             for k in range(len(jacket.PANELS))]  # fmt: skip
+    for i, (lo_a, hi_a) in enumerate(boxes):
+        for lo_b, hi_b in boxes[i + 1:]:
+            apart = (hi_a < lo_b) | (hi_b < lo_a)
+            assert apart.any(), "two jacket charts overlap in the texture"
+    assert piece.layout.scale * 2048 / 1000 >= 1.2
+    # Sleeves are the faces round the arms, body panels the torso's.
+    v = piece.mesh.vertices[piece.mesh.faces].mean(axis=1)
+    sleeve = panels.face_panel >= 4
+    assert np.abs(v[sleeve, 0]).min() > 0.12 and np.abs(v[~sleeve, 0]).max() < 0.3
+
+
+def test_jacket_zip_runs_down_the_front_opening_in_metal(body, piece, maps):
+    teeth = np.concatenate([m.points for m in _kinds(piece, "rivet")])
+    assert len(teeth) > 150  # two halves, a tooth every 3.5 mm over ~40 cm
+    where = _on_mesh(piece, teeth)
+    front = where[:, 1] < body.marks.neck[1]
+    assert front.mean() > 0.95 and np.percentile(np.abs(where[:, 0]), 95) < 0.05
+    assert np.ptp(where[:, 2]) > 0.3  # hem band to collar
+    canvas = tailored.Canvas(maps.base_color_texture.shape[0])
+    tilt = _tilt(maps)
+    colour = maps.base_color_texture.astype(float).mean(axis=2)
+    d, _, w = canvas.distance(teeth[: len(teeth) // 2], 3)
+    on_teeth = d < 1.0
+    assert tilt[w][on_teeth].mean() > 3 * np.median(tilt)  # domed teeth, not flat leather
+    assert colour[w][on_teeth].mean() > 2 * np.median(colour)  # nickel on black
+
+
+def test_jacket_has_welt_pockets_and_ridged_seams_where_a_tailor_puts_them(body, piece, maps):
+    patches = _kinds(piece, "patch")
+    assert len(patches) == 3  # two lower welts and a chest pocket
+    centres = _on_mesh(piece, np.array([p.points.mean(axis=0) for p in patches]))
+    m = body.marks
+    assert (centres[:, 1] < m.neck[1]).all()  # on the fronts
+    low = centres[:, 2] < m.waist_z + 0.05
+    assert low.sum() == 2 and np.sign(centres[low, 0]).sum() == 0  # one each side
+    assert centres[~low, 0] > 0 and centres[~low, 2] > m.chest_z - 0.05  # wearer's left chest
+    tilt = _tilt(maps)
+    canvas = tailored.Canvas(tilt.shape[0])
+    plain = np.median(tilt)
+    for p in patches:
+        d, _, w = canvas.distance(p.points, 3, closed=True)
+        assert tilt[w][d < 1.5].mean() > 1.5 * plain
+    seams = _kinds(piece, "seam")[0].points  # side, shoulder, centre-back, armhole
+    d, _, w = canvas.distance(seams, 3)
+    assert tilt[w][d < 1.5].mean() > 1.5 * plain
+    stitches = _kinds(piece, "stitch")
+    assert sum(len(s.points) for s in stitches) > 500  # topstitching beside every seam
+
+
+def test_jacket_fabric_and_colour_variants_keep_its_construction(piece, maps):
+    spec = builtin.BY_NAME["jacket"]
+    canvas_jacket = builtin.look(replace(spec, fabric="canvas", colour="khaki"), piece.layout, 256)
+    assert canvas_jacket.extras["tailored"] and canvas_jacket.extras["fabric"] == "canvas"
+    assert maps.extras["fabric"] == "leather"
+    # Leather is a matte-to-satin grain, not glitter: roughness stays in a narrow band.
+    rough = maps.roughness_texture.astype(float) / 255
+    leather = rough[rough > np.percentile(rough, 5)]
+    assert 0.45 < np.median(leather) < 0.8 and np.percentile(leather, 95) - np.percentile(
+        leather, 5) < 0.3  # fmt: skip
