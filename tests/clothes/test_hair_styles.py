@@ -159,6 +159,22 @@ def test_bob_ends_turn_in_and_vary_in_length(body):
     assert bend.max() < 60
 
 
+def test_bob_falls_clear_of_the_ears(body):
+    """At ear level a bob's cards fall straight past the ears: once out from the head's
+    vertical axis, a card does not come back in by more than 3 mm before its curled end
+    (pushed out over the ear and back in under it, 37 % of the cards dipped by up to
+    11 mm: loops sticking out at ear level)."""
+    centre, eye_z = hair.head_frame(body)
+    lines = hair.hang_cards(body, hair.flow_parted()).mesh.vertices.reshape(-1, 2, 11, 3)
+    lines = lines.mean(axis=1).astype(np.float64)
+    radius = np.hypot(lines[..., 0] - centre[0], lines[..., 1] - centre[1])
+    ears = (lines[..., 2] > eye_z - 0.05) & (lines[..., 2] < eye_z + 0.03)
+    widest = np.maximum.accumulate(np.where(ears, radius, -np.inf), axis=1)
+    dip = np.where(ears, widest - radius, 0.0).max(axis=1)
+    assert (dip > 0.003).mean() < 0.05, (dip > 0.003).mean()
+    assert dip.max() < 0.006, dip.max()
+
+
 def test_long_hair_lies_on_the_scalp_over_the_head(body):
     """Over the head the long locks lie on the scalp, under the hair grown there (they
     hung from MakeHuman's hair ribbons, which stand off the crown, and lifted at once:

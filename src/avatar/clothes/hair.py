@@ -634,7 +634,7 @@ def hang_cards(
         gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
-    path = np.stack(rows, 1)  # (N, K+1, 3)
+    path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
     stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
     path = _curl_in(body, _cut_at(path, stop), centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
@@ -642,6 +642,22 @@ def hang_cards(
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
     return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
+
+
+def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarray:
+    """(N, K, 3) hanging paths that, below the height ``below``, never come back in
+    towards the head's vertical axis (through ``centre``) once out: hair falls straight
+    past the widest point under it (an ear, the back of the skull) instead of following
+    the skin back in. (Kept off the skin point by point, cards pushed out over the ears
+    dipped back in under them by up to a centimetre: loops sticking out at ear level.)"""
+    rel = (path - centre)[..., :2]
+    radius = np.linalg.norm(rel, axis=-1)
+    hanging = path[..., 2] < below
+    widest = np.maximum.accumulate(np.where(hanging, radius, 0.0), axis=1)
+    scale = np.where(hanging, widest / np.maximum(radius, 1e-9), 1.0)
+    out = path.copy()
+    out[..., :2] = centre[:2] + rel * scale[..., None]
+    return out
 
 
 def _layers(path: np.ndarray, centre: np.ndarray, free: np.ndarray, rng) -> np.ndarray:
