@@ -338,7 +338,12 @@ def beard_undercoat(body: AuthoringBody) -> Piece:
     p = mesh.vertices.astype(np.float64)
     angle = np.arctan2(p[:, 0], -(p[:, 1] - centre[1]))
     u = angle * fh.ARC_RADIUS_M / UNDERCOAT_TILE_M
-    v = fh.undercoat_v(facial_hair_density(body, "beard", p))
+    # Where the beard is full, v also climbs up the face (within the fully covered rows):
+    # at one v the texture's tangent along v (the hairs' direction for the anisotropic
+    # highlight) was undefined, and the chin shone as one smooth shell.
+    density = facial_hair_density(body, "beard", p)
+    up = (p[:, 2] - p[:, 2].min()) / max(float(np.ptp(p[:, 2])), 1e-6)
+    v = fh.undercoat_v(density) + fh.UNDERCOAT_CLIMB * np.clip(density, 0, 1) * up
     uv = np.stack([u, v], -1)[mesh.faces].reshape(-1, 2)
     return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
 

@@ -75,6 +75,7 @@ def grey_share(age: float) -> float:
 # hair layout (v in [0.5, 1]): its hairs cover none of the skin at v = UNDERCOAT_V[0] and
 # all of it from UNDERCOAT_V[1] up.
 UNDERCOAT_V = (0.52, 0.9)
+UNDERCOAT_CLIMB = 0.09  # where it is full, v climbs this much up the face (from 0.9)
 
 
 def undercoat_v(density: np.ndarray) -> np.ndarray:
