@@ -33,6 +33,7 @@ PANELS = (*tailoring.TROUSER_PANELS,  # left front, left back, right front, righ
           Panel("left sleeve", 1, False), Panel("right sleeve", -1, False))
 BODY, SLEEVES = (0, 1, 2, 3), (4, 5)
 ZIP_TOOTH = 0.0035  # m between zip teeth
+COLLAR_REACH = 0.075  # m round the neck from the front opening (or centre back) to the shoulder
 THREAD = "charcoal"  # topstitching a shade off black leather
 ZIP_METAL = (0.5, 0.5, 0.52)  # nickel zip teeth and pulls (linear RGB)
 
@@ -57,6 +58,11 @@ class JacketPanels(tailoring.Panels):
         sleeve = _on_sleeve(body, centre)
         axis = tailoring.body_axis(body.marks)
         back = centre[:, 1] > axis(side, centre[:, 2])[:, 1]
+        # Over the shoulders front and back meet along the ridge (the cloth's highest line
+        # at each distance out from the neck), not the hips' plane: split there, the
+        # shoulder seam zig-zagged across the front of the shoulder.
+        high = (centre[:, 2] > body.marks.shoulder[0, 2] - 0.03) & (np.abs(centre[:, 0]) > 0.07)
+        back = np.where(high, centre[:, 1] > _ridge_y(v, np.abs(centre[:, 0])), back)
         c = f.shape[1]
         body_uz = tailoring.panel_coordinates(corners.reshape(-1, 3), np.repeat(side, c),
                                               np.repeat(back, c), axis).reshape(f.shape + (2,))
@@ -106,6 +112,17 @@ class JacketPanels(tailoring.Panels):
             near = np.abs(uz[:, 0] - x) < 0.015
             out[i] = uz[near, 1].max() if near.any() else self.hi[panel, 1]
         return out
+
+
+def _ridge_y(v: np.ndarray, across: np.ndarray, step: float = 0.01) -> np.ndarray:
+    """(N,) y of the cloth's highest vertex within ``step`` m of each distance ``across``
+    (N,) from the midline (the ridge over the shoulders)."""
+    bins = np.round(np.abs(v[:, 0]) / step).astype(int)
+    out = np.empty(len(across))
+    for i, b in enumerate(np.round(across / step).astype(int)):
+        near = np.abs(bins - b) <= 1
+        out[i] = v[near][np.argmax(v[near, 2]), 1] if near.any() else 0.0
+    return out
 
 
 def _on_sleeve(body: AuthoringBody, centre: np.ndarray) -> np.ndarray:
@@ -211,15 +228,16 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
         out += [Mark("seam", _across(panels, k, band)),
                 Mark("stitch", _across(panels, k, band + 0.005), 0.0008),
                 Mark("stitch", _across(panels, k, hem + 0.008), 0.0008)]  # fmt: skip
-        lo, hi = panels.lo[k, 0], panels.hi[k, 0]
-        u = np.linspace(lo + 0.004, hi - 0.004, 60)
+        # The collar band: sewn on 4 cm below the neckline, topstitched both sides, round
+        # the neck only (COLLAR_REACH m from the front opening or the centre back), along
+        # the neckline smoothed (it steps with the faces).
+        start = panels.lo[k, 0] + 0.004
+        u = np.linspace(start, start + COLLAR_REACH, 24)
         top = panels.top(k, u)
-        # The collar band: sewn on 4 cm below the neckline, topstitched both sides; only
-        # where the top edge is the neckline (not over the shoulder, where the sleeve is).
-        neck = top > marks.shoulder[0, 2] + 0.06
-        out += [Mark("seam", _line(panels, k, u[neck], top[neck] - 0.04)),
-                Mark("stitch", _line(panels, k, u[neck], top[neck] - 0.035), 0.0008),
-                Mark("stitch", _line(panels, k, u[neck], top[neck] - 0.007), 0.0008)]
+        top = np.polyval(np.polyfit(u, top, 2), u)
+        out += [Mark("seam", _line(panels, k, u, top - 0.04)),
+                Mark("stitch", _line(panels, k, u, top - 0.035), 0.0008),
+                Mark("stitch", _line(panels, k, u, top - 0.007), 0.0008)]
         inner = lambda z, k=k: _edge(panels, k, np.array([z]), False)[0]  # noqa: E731
         outer = lambda z, k=k: _edge(panels, k, np.array([z]), True)[0]  # noqa: E731
         if PANELS[k].back:
@@ -236,7 +254,6 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
             z = marks.chest_z + 0.03
             centre = np.array([inner(z) + 0.075, z])
             out += _welt(panels, k, centre, 0.1, 0.016, 0.12)
-    elbow = -float(np.linalg.norm(marks.elbow[0] - marks.shoulder[0]))
     for k in SLEEVES:  # cuffs: a band 5 cm deep at the wrist, topstitched; the underarm seam
         end = float(panels.lo[k, 1])
         out += [Mark("seam", _across(panels, k, end + 0.05)),
@@ -246,10 +263,6 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
         out += [Mark("stitch", _line(panels, k, _edge(panels, k, down, outer) + d, down),
                      0.0008)
                 for outer, d in ((False, 0.005), (True, -0.005))]  # fmt: skip
-        for j in range(3):  # soft folds in the crook of the elbow (its front)
-            u = np.linspace(0.03, 0.09, 10)
-            out.append(Mark("fold", _line(panels, k, u, elbow + 0.02 * (j - 1)
-                                          + 0.2 * (u - 0.06) ** 2), 0.004, 0.6))  # fmt: skip
     return out
 
 
