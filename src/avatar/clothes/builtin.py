@@ -665,10 +665,10 @@ SPECS = [
     Spec("dress", "dresses", _dress, "cotton", "teal", DRESS_THICKNESS, 38, ("dress",), clearance=DRESS_CLEARANCE),  # noqa: E501
     Spec("swimsuit", "swimwear", lambda b: _tights(b, swimsuit, 0.001, snug=SNUG), "lycra", "sky", SNUG_THICKNESS, 25, ("swimwear", "one-piece")),  # noqa: E501
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
-    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoe_look("calf", "brown", "sole brown", sole="sole")),  # noqa: E501
-    Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoe_look("calf", "black", "sole black", sole="sole")),  # noqa: E501
-    Spec("sneakers", "footwear", shoes.shoes, "canvas", "white", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoe_look("canvas", "white", "white", cap_colour="light grey")),  # noqa: E501
-    Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoe_look("calf", "dark brown", "sole black", sole="sole")),  # noqa: E501
+    Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoes.look("calf", "brown", "sole", "sole brown")),  # noqa: E501
+    Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoes.look("calf", "black", "sole", "sole black")),  # noqa: E501
+    Spec("sneakers", "footwear", shoes.sneakers, "canvas", "light grey", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoes.look("canvas", "light grey", "rubber", "white", cap_colour="grey", trim=("canvas", "navy"), band="navy")),  # noqa: E501
+    Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoes.look("calf", "dark brown", "sole", "sole black")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.0, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
     Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501

@@ -9,19 +9,30 @@ Parts, per foot (``x > 0`` is the body's left):
 - sole: a thin edge (``_sole_edge``) round the upper's bottom edge, out by a welt, down to
   a tread a little below the foot, taller at the heel (a heel block), lifted under the
   arch and curling up at the toe (toe spring), closed underneath;
-- toe cap: the front of the upper again, sewn flat on it (under a millimetre out);
-- laces: bars across the instep, lying on the upper.
+- toe cap: the front of the upper again, sewn flat on it (under a millimetre out), its
+  back edge (the seam over the vamp) double-stitched;
+- lacing (``lacing``): a tongue under the laces, two quarters' facings either side of it
+  with eyelets, and one lace criss-crossing from eyelet to eyelet (each crossing over the
+  one before), tied in a bow at the top;
+- a sneaker (``SNEAKER``) on a deep rubber midsole wrapping up over the toe (a toe
+  bumper), with a band moulded round it, and a heel tab.
 
-The four share one material: an atlas (``looks.atlas``) whose rows hold leather, toe-cap
-leather, rubber and lace cord, each piece's UVs laid out inside its row.
+They share one material: an atlas (``look``) whose rows hold leather, trim (eyelets, a
+sneaker's facings and heel tab), toe-cap leather, sole and lace cord, each piece's UVs
+laid out inside its row; the toe cap's and sole's UVs run from their seams, so stitching
+drawn across the atlas follows the cap's edge and the welt.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from avatar.clothes import regions
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join
+from avatar.looks import fabrics
+from avatar.material import Material
 from avatar.mesh import Mesh
 
 EASE = 0.005  # m between foot and upper (less let toes and socks through mid-stride)
@@ -45,10 +56,34 @@ OPEN_BOTTOM = 0.012
 EDGE = 0.002
 SOCK_ROOM = 0.001  # m a smoothed toe box may sink inside the cut (a sock is 2 mm inside)
 DRAWN_CLEAR = 0.003  # m over the ease the drawn edge keeps: room for a sock where the foot flares
-LACES = 5  # bars across the instep
+LACES = 5  # eyelet pairs up each side of the lacing
 
-# Atlas rows (v0, v1) in the shoe material: leather upper, toe cap, sole rubber, laces.
-ROWS = {"upper": (0.5, 1.0), "cap": (0.3, 0.5), "sole": (0.1, 0.3), "laces": (0.0, 0.1)}
+# Atlas rows (v0, v1) in the shoe material: leather upper, trim, toe cap, sole, laces.
+ROWS = {"upper": (0.6, 1.0), "trim": (0.5, 0.6), "cap": (0.3, 0.5), "sole": (0.1, 0.3),
+        "laces": (0.0, 0.1)}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Style:
+    """How a shoe is made: its sole (m: tread under the foot, how far its edge rises over
+    the upper, the heel block, the welt, how far the edge rises round the toe), and its
+    trim (a heel tab; the atlas row of the lacing's facings)."""
+
+    under: float = UNDER
+    cover: float = COVER
+    heel: float = HEEL
+    welt: float = WELT
+    bumper: float = 0.0
+    heel_tab: bool = False
+    facings: str = "upper"
+
+
+SHOE = Style()
+# A sneaker: a 15 mm rubber midsole under the foot rising 11 mm up the upper (its edge
+# ~3 cm tall at the ball, against a leather shoe's ~1 cm), 2.4 cm at the heel, wrapping
+# 1.3 cm further up round the toe (the toe bumper); contrasting facings and a heel tab.
+SNEAKER = Style(under=0.015, cover=0.011, heel=0.024, welt=0.0035, bumper=0.013,
+                heel_tab=True, facings="trim")  # fmt: skip
 
 
 class Foot:
@@ -119,7 +154,36 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     keep = _shoe_faces(body, foot, faces) & (foot.along(centre) > 0.78)
     mesh = cut(body, faces, keep, CAP_EASE, relax=8)
     mesh = _toe_box(body, foot, mesh, CAP_EASE)  # drawn down too, a sock showed at its corner
-    return bound(body, _planar_uvs(mesh, "cap"), faces)
+    return bound(body, _cap_uvs(mesh, foot), faces)
+
+
+CAP_UV_REACH = 0.1  # m from the toe cap's seam that its row's height spans
+
+
+def _cap_uvs(mesh: Mesh, foot: Foot) -> Mesh:
+    """The toe cap's UVs: u round the foot, v from its seam (its back edge, over the vamp:
+    the open edge above the sole's) towards the tip, so the atlas's stitch rows run
+    parallel to the seam, a few millimetres in front of it."""
+    from avatar.geometry.shell import boundary_edges
+
+    planar = _planar_uvs(mesh, "cap")
+    v = mesh.vertices.astype(np.float64)
+    rim = np.unique(boundary_edges(mesh.faces)[0])
+    seam = rim[v[rim, 2] > foot.ground + OPEN_BOTTOM + 0.004]
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(v[seam]).query(v[mesh.faces.reshape(-1)])
+    w = 1 - np.clip(d / CAP_UV_REACH, 0, 1)
+    v0, v1 = ROWS["cap"]
+    uvs = planar.uvs.copy()  # type: ignore[union-attr]
+    uvs[:, 1] = v0 + (v1 - v0) * (0.05 + 0.9 * w)
+    return Mesh(mesh.vertices, mesh.faces, uvs, planar.face_uvs)
+
+
+def cap_stitch_v(mm: float) -> float:
+    """Atlas v of a stitch row ``mm`` millimetres in front of the toe cap's seam."""
+    v0, v1 = ROWS["cap"]
+    return v0 + (v1 - v0) * (0.05 + 0.9 * (1 - mm / 1000 / CAP_UV_REACH))
 
 
 def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float) -> Mesh:
@@ -180,7 +244,7 @@ def _at_least(body: AuthoringBody, points: np.ndarray, gap: float) -> np.ndarray
     return out
 
 
-def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
+def sole(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> Piece:
     """The sole under an upper: its lowest boundary loop extruded out and down, capped."""
     loop = _lowest_loop(top.mesh)
     ring = top.mesh.vertices[loop].astype(np.float64)
@@ -202,13 +266,14 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     ring = ring.copy()
     ring[:, :2] += extra[:, None] * out
     t = foot.along(ring)
-    edge, tread = _sole_edge(ring, t, foot)
+    edge, tread = _sole_edge(ring, t, foot, style)
+    welt = style.welt
     rings = [
         np.column_stack([ring[:, :2] - 0.001 * out - extra[:, None] * out,
                          edge + 0.001]),  # tucked under the upper's edge
-        np.column_stack([ring[:, :2] + WELT * out, edge]),  # welt top
-        np.column_stack([ring[:, :2] + WELT * out, tread + 0.002]),
-        np.column_stack([ring[:, :2] + (WELT - 0.0015) * out, tread]),  # the edge rounded
+        np.column_stack([ring[:, :2] + welt * out, edge]),  # welt top
+        np.column_stack([ring[:, :2] + welt * out, tread + 0.002]),
+        np.column_stack([ring[:, :2] + (welt - 0.0015) * out, tread]),  # the edge rounded
     ]
     n = len(ring)
     # The tread's middle, under the arch: lifted as the arch's edge is, by half.
@@ -223,67 +288,374 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
     faces += [[bottom + (i + 1) % n, bottom + i, middle, middle] for i in range(n)]
     mesh = Mesh(points.astype(np.float32), np.array(faces, np.int32))
     mesh = _facing_out(mesh, centre + [0, 0, 0.02])
-    return bound(body, _planar_uvs(mesh, "sole"), body.group_faces("helper-tights"))
+    mesh = _planar_uvs(mesh, "sole")
+    # v by ring (the welt's top lip, the wall, the tread), so a stitch row or a moulded
+    # band drawn across the atlas runs round the sole at one place on its edge.
+    height = np.concatenate([np.repeat(SOLE_RINGS, n), [0.0]])[mesh.faces.reshape(-1)]
+    v0, v1 = ROWS["sole"]
+    uvs = mesh.uvs.copy()  # type: ignore[union-attr]
+    uvs[:, 1] = v0 + (v1 - v0) * (0.05 + 0.9 * height)
+    mesh = Mesh(mesh.vertices, mesh.faces, uvs, mesh.face_uvs)
+    return bound(body, mesh, body.group_faces("helper-tights"))
 
 
-def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot) -> tuple[np.ndarray, np.ndarray]:
+# The sole's rings' places in its atlas row (0 the tread's middle, 1 the edge tucked under
+# the upper): the welt's top lip spans 0.9-1, the wall 0.1-0.9.
+SOLE_RINGS = (1.0, 0.9, 0.1, 0.05)
+
+
+def sole_v(place: float) -> float:
+    """Atlas v of a ``place`` on the sole's edge (``SOLE_RINGS``: 0.1 bottom of the wall,
+    0.9 its top, 0.95 on the welt's lip)."""
+    v0, v1 = ROWS["sole"]
+    return v0 + (v1 - v0) * (0.05 + 0.9 * place)
+
+
+def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot,
+               style: Style = SHOE) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(top (n,), tread (n,)) z of the sole's edge round the ``ring`` (n, 3) of the upper's
     bottom edge at ``t`` (n,) along the foot: the top COVER over the upper's edge (smoothed
     round the ring, at least HEEL above the ground behind the heel's breast); the tread
     flat under heel and ball, lifted ARCH under the arch and SPRING at the toe's tip."""
-    top = ring[:, 2] + COVER
+    top = ring[:, 2] + style.cover
     for _ in range(6):  # the upper's edge follows whole helper faces: a ragged line
         smooth = 0.5 * top + 0.25 * (np.roll(top, 1) + np.roll(top, -1))
-        top = np.maximum(ring[:, 2] + COVER, smooth)
+        top = np.maximum(ring[:, 2] + style.cover, smooth)
     heel = np.clip((0.3 - t) / 0.06, 0, 1)  # the heel block ends at its breast, t ~ 0.27
-    top = np.maximum(top, foot.ground + HEEL * heel)
+    top = np.maximum(top, foot.ground + style.heel * heel)
+    toe = np.clip((t - 0.82) / 0.12, 0, 1)
+    top = top + style.bumper * toe * toe * (3 - 2 * toe)  # a sneaker's toe bumper
     arch = ARCH * np.clip(1 - np.abs(t - 0.45) / 0.15, 0, 1) ** 0.5
     spring = SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
-    tread = foot.ground - UNDER + arch + spring
+    tread = foot.ground - style.under + arch + spring
     return top, np.minimum(tread, top - 0.004)
 
 
-def laces(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
-    """Bars across the instep, each a strip 5 mm wide lying 1.5 mm over the upper."""
+# Heights (m) over the upper's surface of the lacing's layers: the tongue, the quarters'
+# facings on it, eyelets in the facings, the lace through them (its crown a little higher
+# again, and higher still where it crosses over the one before).
+TONGUE_LIFT, FACING_LIFT, EYELET_LIFT, LACE_LIFT = 0.0005, 0.0011, 0.0015, 0.0019
+LACE_WIDTH = 0.0035
+LACE_ROWS = (0.72, 0.47)  # along the foot: the lowest eyelets (towards the toes), the top
+
+
+class _Surface:
+    """Rays against an upper (its quads as triangles): where a vertical ray from above,
+    or a ray from behind, first meets the leather."""
+
+    def __init__(self, mesh: Mesh):
+        f = mesh.faces
+        tris = np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
+        self.v = mesh.vertices.astype(np.float64)
+        self.tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2])
+                         & (tris[:, 0] != tris[:, 2])]  # fmt: skip
+
+    def hit(self, origins: np.ndarray, direction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(points (N, 3), unit normals facing the ray's origin (N, 3), hit (N,) bool) of
+        rays from ``origins`` (N, 3) along ``direction`` (3,) (Moller-Trumbore)."""
+        d = np.asarray(direction, np.float64)
+        a, b, c = (self.v[self.tris[:, i]] for i in range(3))
+        e1, e2 = b - a, c - a
+        p = np.cross(d, e2)
+        det = np.einsum("td,td->t", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1 / np.where(ok, det, 1), 0)
+        s = origins[:, None] - a[None]  # (N, T, 3)
+        u = np.einsum("ntd,td->nt", s, p) * inv
+        q = np.cross(s, e1[None])
+        w = np.einsum("d,ntd->nt", d, q) * inv
+        dist = np.einsum("ntd,td->nt", q, e2) * inv
+        inside = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (dist > 0)
+        dist = np.where(inside, dist, np.inf)
+        first = np.argmin(dist, axis=1)
+        found = np.isfinite(dist[np.arange(len(origins)), first])
+        points = origins + np.where(found, dist[np.arange(len(origins)), first], 0)[:, None] * d
+        normal = np.cross(e1, e2)[first]
+        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+        normal *= -np.sign(normal @ d)[:, None]
+        return points, normal, found
+
+    def over(self, xy: np.ndarray, lift: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points ``lift`` m above the upper's top at xy (N, 2), their normals, hit."""
+        origins = np.column_stack([xy, np.full(len(xy), self.v[:, 2].max() + 0.05)])
+        points, normal, found = self.hit(origins, (0.0, 0.0, -1.0))
+        return points + lift * normal, normal, found
+
+
+@dataclass(frozen=True)
+class Lacing:
+    """Where a shoe's lacing is: eyelet rows ``y`` (K,) from the toes up, the throat's
+    middle ``x`` (K,) and its half-width ``half`` (K,) at each."""
+
+    y: np.ndarray
+    x: np.ndarray
+    half: np.ndarray
+
+    def eyelets(self, side: int) -> np.ndarray:
+        """(K, 2) xy of the eyelets on one quarter (side -1 or +1)."""
+        return np.column_stack([self.x + side * self.half, self.y])
+
+
+def _lacing(foot: Foot, top: Piece, rows: int = LACES) -> Lacing:
+    """The lacing's plan on an upper: rows from LACE_ROWS[0] up the instep to LACE_ROWS[1],
+    or as far as both eyelets of the top row still lie on the leather (the throat)."""
     v = top.mesh.vertices.astype(np.float64)
     t = foot.along(v)
-    strips = []
-    for k in range(LACES):
-        at = 0.48 + 0.22 * k / (LACES - 1)  # from the ankle's front towards the toes
-        band = np.abs(t - at) < 0.03
-        if not band.any():
-            continue
-        highest = v[band][np.argmax(v[band][:, 2])]
-        across = np.linspace(-0.014, 0.014, 7)
-        y = highest[1]
-        points = []
-        for dx in across:
-            x = highest[0] + dx
-            near = np.hypot(v[:, 0] - x, v[:, 1] - y) < 0.008
-            z = v[near, 2].max() if near.any() else highest[2]
-            points.append([x, y, z + 0.0015])
-        centre = np.array(points)
-        # Crossed, as laced shoes are: each bar slants a little, alternating.
-        slant = 0.004 * (1 if k % 2 else -1) * np.linspace(-1, 1, len(centre))
-        front = centre + np.column_stack([np.zeros(len(centre)), -0.0025 + slant,
-                                          np.zeros(len(centre))])  # fmt: skip
-        back = centre + np.column_stack([np.zeros(len(centre)), 0.0025 + slant,
-                                         np.full(len(centre), 0.0005)])  # fmt: skip
-        strips.append(_strip(front, back))
-    mesh = _merge(strips)
-    return bound(body, _planar_uvs(mesh, "laces"), body.group_faces("helper-tights"))
+    surface = _Surface(top.mesh)
+    for highest in np.arange(LACE_ROWS[1], LACE_ROWS[0] - 0.1, 0.01):
+        at = np.linspace(LACE_ROWS[0], highest, rows)
+        x = np.empty(rows)
+        for k, tk in enumerate(at):  # the instep's ridge: the upper's highest point there
+            band = np.abs(t - tk) < 0.03
+            x[k] = v[band][np.argmax(v[band][:, 2]), 0] if band.any() else foot.centre_x
+        x = np.polyval(np.polyfit(at, x, 1), at)  # one straight throat
+        y = foot.heel_y - at * (foot.heel_y - foot.toe_y)
+        half = 0.0095 + 0.0045 * (LACE_ROWS[0] - at) / (LACE_ROWS[0] - LACE_ROWS[1])
+        plan = Lacing(y, x, half)
+        ends = np.concatenate([plan.eyelets(-1)[-1:], plan.eyelets(1)[-1:]])
+        top_xy = ends + [0, 0.006]  # the tongue's end and the knot, beyond the top pair
+        if surface.over(np.concatenate([ends, top_xy]), 0.0)[2].all():
+            break
+    return plan
 
 
-def shoes(body: AuthoringBody, top: float = 0.96) -> Piece:
+def _ribbon(points: np.ndarray, normals: np.ndarray, width: float, crown: float) -> Mesh:
+    """A strip along a polyline (M, 3) lying on a surface of ``normals`` (M, 3): three
+    vertices across (edges and a crown ``crown`` m higher), so it shades as a cord."""
+    tangent = np.gradient(points, axis=0)
+    tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-12)
+    side = np.cross(normals, tangent)
+    side /= np.maximum(np.linalg.norm(side, axis=1, keepdims=True), 1e-12)
+    across = [points - side * width / 2, points + normals * crown, points + side * width / 2]
+    n = len(points)
+    faces = [[j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i]
+             for j in range(2) for i in range(n - 1)]  # fmt: skip
+    return Mesh(np.concatenate(across).astype(np.float32), np.array(faces, np.int32))
+
+
+def _sheet(surface: _Surface, xy: np.ndarray, lift: float) -> Mesh | None:
+    """A grid (R, C, 2) of xy laid ``lift`` m over the upper (rows missing it dropped)."""
+    r, c = xy.shape[:2]
+    points, _, found = surface.over(xy.reshape(-1, 2), lift)
+    keep = found.reshape(r, c).all(axis=1)
+    if keep.sum() < 2:
+        return None
+    grid = points.reshape(r, c, 3)[keep]
+    r = len(grid)
+    idx = np.arange(r * c).reshape(r, c)
+    faces = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], -1).reshape(-1, 4)
+    return Mesh(grid.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
+
+
+def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> list[Piece]:
+    """The lacing on an upper: a tongue, the quarters' facings with their eyelets, and the
+    lace criss-crossing between them, one strip from bow to bow (``lace``)."""
+    surface = _Surface(top.mesh)
+    plan = _lacing(foot, top)
+    faces = body.group_faces("helper-tights")
+    along = np.linspace(plan.y[0] - 0.012, plan.y[-1] + 0.006, 9)  # toes to throat
+    x = np.interp(along, plan.y[::-1], plan.x[::-1])
+    half = np.interp(along, plan.y[::-1], plan.half[::-1])
+    tongue = _sheet(surface, np.stack([np.column_stack([x + f * (half + 0.004), along])
+                                       for f in np.linspace(-1, 1, 5)], 1), TONGUE_LIFT)
+    pieces = []
+    if tongue is not None:
+        pieces.append(bound(body, _planar_uvs(tongue, "upper"), faces))
+    facings = []
+    for side in (-1, 1):
+        across = [half - 0.005, half + 0.002, half + 0.009]
+        grid = np.stack([np.column_stack([x + side * a, along]) for a in across], 1)
+        sheet = _sheet(surface, grid, FACING_LIFT)
+        if sheet is not None:
+            facings.append(sheet)
+    if facings:
+        pieces.append(bound(body, _planar_uvs(_merge(facings), style.facings), faces))
+    eyelets = [_disc(surface, xy, 0.0024) for side in (-1, 1) for xy in plan.eyelets(side)]
+    pieces.append(bound(body, _planar_uvs(_merge(eyelets), "trim"), faces))
+    pieces.append(bound(body, _planar_uvs(lace(surface, plan), "laces"), faces))
+    return pieces
+
+
+def _disc(surface: _Surface, xy: np.ndarray, radius: float, sides: int = 6) -> Mesh:
+    """An eyelet: a disc ``radius`` m round xy lying EYELET_LIFT over the upper."""
+    angle = np.linspace(0, 2 * np.pi, sides, endpoint=False)
+    ring = xy + radius * np.column_stack([np.cos(angle), np.sin(angle)])
+    points, _, _ = surface.over(np.concatenate([[xy], ring]), EYELET_LIFT)
+    faces = [[0, 1 + i, 1 + (i + 1) % sides, 0] for i in range(sides)]
+    return Mesh(points.astype(np.float32), np.array(faces, np.int32))
+
+
+def lace(surface: _Surface, plan: Lacing) -> Mesh:
+    """One lace: straight across the lowest eyelets, then each end up to the next eyelet on
+    the far side (criss-cross: the two ends cross between every pair of rows, the end
+    coming from the right over the one from the left), up to a knot above the top pair,
+    tied in a bow (two loops and two tails)."""
+    left, right = plan.eyelets(-1), plan.eyelets(1)
+    k = len(plan.y)
+    # The path through the eyelets: L(K-1) ... R1, L0 | R0, L1, R2 ... (one strip).
+    up_a = [left[i] if i % 2 == 0 else right[i] for i in range(k)]  # from L0
+    up_b = [right[i] if i % 2 == 0 else left[i] for i in range(k)]  # from R0
+    knot = np.array([plan.x[-1], plan.y[-1] + 0.004])
+    path, lift = [], []
+
+    def run(a, b, rise: float, steps: int = 5) -> None:
+        s = np.linspace(0, 1, steps, endpoint=False)
+        path.extend(a + s[:, None] * (b - a))
+        lift.extend(LACE_LIFT + rise * np.sin(np.pi * s))
+
+    bow = _bow(knot, plan.half[-1])
+    for a, b in zip(bow[0][:-1], bow[0][1:], strict=True):  # tail, loops, back to the knot
+        run(a, b, 0.0015, 2)
+    run(knot, up_a[-1], 0.0008, 3)
+    for a, b in zip(up_a[::-1][:-1], up_a[::-1][1:], strict=True):  # down one end
+        run(a, b, 0.0003)
+    run(left[0], right[0], 0.0006)  # across the lowest pair
+    for a, b in zip(up_b[:-1], up_b[1:], strict=True):  # up the other, over the first
+        run(a, b, 0.0012)
+    run(up_b[-1], knot, 0.0008, 3)
+    for a, b in zip(bow[1][:-1], bow[1][1:], strict=True):
+        run(a, b, 0.0015, 2)
+    path.append(bow[1][-1])
+    lift.append(LACE_LIFT)
+    xy = np.asarray(path)
+    points, normal, found = surface.over(xy, 0.0)
+    # Past the upper's edge (a loop's end over the opening): at its neighbours' height.
+    index = np.arange(len(xy))
+    points[~found, 2] = np.interp(index[~found], index[found], points[found, 2])
+    normal[~found] = (0.0, 0.0, 1.0)
+    points = points + np.asarray(lift)[:, None] * normal
+    return _ribbon(points, normal, LACE_WIDTH, 0.0007)
+
+
+def _bow(knot: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
+    """(first, second) xy polylines of a bow: the first from one tail's end to the knot and
+    round its loop back to it, the second round the other loop and out to the other tail."""
+    phi = np.linspace(0, 2 * np.pi, 10)
+
+    def loop(side: int) -> np.ndarray:
+        return knot + np.column_stack([side * (half + 0.012) * (1 - np.cos(phi)) / 2,
+                                       0.009 * side * np.sin(phi)])  # fmt: skip
+
+    def tail(side: int) -> np.ndarray:  # from the knot out to its end
+        return knot + np.linspace(0, 1, 4)[:, None] * [side * 0.008, -0.03]
+
+    return np.concatenate([tail(-1)[::-1], loop(-1)[1:]]), np.concatenate([loop(1), tail(1)[1:]])
+
+
+def heel_tab(body: AuthoringBody, foot: Foot, top: Piece) -> Piece:
+    """A sneaker's heel tab: a strip 2.4 cm wide down the back of the heel from 9 mm above
+    the collar (a pull loop) to 3.5 cm below it, a millimetre over the upper."""
+    from avatar.geometry.shell import boundary_edges
+
+    surface = _Surface(top.mesh)
+    v = top.mesh.vertices.astype(np.float64)
+    rim = np.unique(boundary_edges(top.mesh.faces)[0])
+    rim = rim[v[rim, 2] > foot.ground + 0.03]
+    collar = v[rim[np.argmin(foot.along(v[rim]))]]
+    zs = collar[2] - np.linspace(0.035, 0.002, 6)
+    xs = collar[0] + np.linspace(-0.012, 0.012, 3)
+    origins = np.array([[x, foot.heel_y + 0.05, z] for z in zs for x in xs])
+    points, normal, found = surface.hit(origins, (0.0, -1.0, 0.0))
+    points = points + 0.001 * normal
+    grid = points.reshape(len(zs), len(xs), 3)
+    ok = found.reshape(len(zs), len(xs)).all(axis=1)
+    grid = grid[ok]
+    # The loop above the collar: on up the heel's line, clear of the skin.
+    slope = grid[-1] - grid[-2]
+    slope /= np.linalg.norm(slope, axis=1, keepdims=True)
+    above = grid[-1] + 0.009 * slope
+    above = _at_least(body, above, EASE + 0.003)
+    grid = np.concatenate([grid, above[None]])
+    r, c = grid.shape[:2]
+    idx = np.arange(r * c).reshape(r, c)
+    faces = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
+    mesh = _facing_out(Mesh(grid.reshape(-1, 3).astype(np.float32), faces.astype(np.int32)),
+                       collar + [0, -0.04, -0.02])  # fmt: skip
+    return bound(body, _planar_uvs(mesh, "trim"), body.group_faces("helper-tights"))
+
+
+def shoes(body: AuthoringBody, top: float = 0.96, style: Style = SHOE) -> Piece:
     """Both shoes, every piece bound to the body's ``helper-tights`` shell; ``top``: how
-    far up the leg the upper reaches (``upper``)."""
+    far up the leg the upper reaches (``upper``); ``style``: a shoe's or a sneaker's."""
     pieces = []
     for side in (0, 1):
         foot = Foot(body, side)
         top_piece = upper(body, foot, top)
-        pieces += [top_piece, toe_cap(body, foot), sole(body, foot, top_piece),
-                   laces(body, foot, top_piece)]
+        pieces += [top_piece, toe_cap(body, foot), sole(body, foot, top_piece, style),
+                   *lacing(body, foot, top_piece, style)]
+        if style.heel_tab:
+            pieces.append(heel_tab(body, foot, top_piece))
     return join(pieces)
+
+
+def sneakers(body: AuthoringBody) -> Piece:
+    """Low sneakers: the shoe on a deep midsole with a toe bumper and a heel tab."""
+    return shoes(body, style=SNEAKER)
+
+
+# ---------------------------------------------------------------------------- look
+
+
+def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
+         cap_colour: str | None = None, trim: tuple[str, str] | None = None,
+         lace_colour=None, band: str | None = None):  # fmt: skip
+    """A shoe's atlas material (``ROWS``) as a ``Spec.look``: the upper's fabric and
+    colour, the sole's; ``cap_colour``: the toe cap's (the upper's if None); ``trim``:
+    (fabric, colour) of eyelets, a sneaker's facings and heel tab (dark leather if None);
+    laces ``builtin.lace_contrast`` to the upper unless ``lace_colour``; ``band``: the
+    colour of a stripe moulded round a sneaker's midsole (with a groove under it).
+    Stitching: double rows 2.5 and 5 mm in front of the toe cap's seam, a row on the
+    welt's lip, and one low on the quarters above the sole."""
+
+    def material(spec, size: int) -> Material:
+        from avatar.clothes.builtin import lace_contrast
+
+        laces = lace_contrast(upper_colour) if lace_colour is None else lace_colour
+        trim_fabric, trim_colour = trim or ("calf", "sole black")
+        stitches = [UPPER_STITCH_V, cap_stitch_v(2.5), cap_stitch_v(5.0)]
+        if band is None:
+            stitches.append(sole_v(0.95))
+        # Rows that fall within 3 texels of one another at this size (the cap's double row
+        # on a small texture) are drawn once: drawn twice the thread came out white.
+        pixel = np.round((1 - np.asarray(stitches)) * size)
+        stitches = [v for i, v in enumerate(stitches) if np.all(np.abs(pixel[:i] - pixel[i]) > 3)]
+        m = fabrics.atlas(spec.name, [
+            (*ROWS["upper"], upper, upper_colour),
+            (*ROWS["trim"], trim_fabric, trim_colour),
+            (*ROWS["cap"], upper, cap_colour or upper_colour),
+            (*ROWS["sole"], sole, sole_colour),
+            (*ROWS["laces"], "cord", laces),
+        ], size, stitches=tuple(stitches))  # fmt: skip
+        if band is not None:
+            _moulded_band(m, fabrics.rgb(band), size)
+        return m
+
+    return material
+
+
+# A stitch low on the upper (quarters and vamp) just above the sole: the upper's v runs
+# with height over its own range, 0.05-0.95 of the row.
+UPPER_STITCH_V = ROWS["upper"][0] + (ROWS["upper"][1] - ROWS["upper"][0]) * (0.05 + 0.9 * 0.1)
+MIDSOLE_STRIPE = (0.62, 0.78)  # the band's span up the midsole's wall (``sole_v`` places)
+MIDSOLE_GROOVE = 0.45
+
+
+def _moulded_band(m: Material, colour: np.ndarray, size: int) -> None:
+    """A stripe of ``colour`` round a midsole's wall, with a moulded groove below it: rows
+    of the sole's atlas row, in place."""
+    def row(place: float) -> int:
+        return int(round((1 - sole_v(place)) * size))
+
+    image, normal = m.base_color_texture, m.normal_texture
+    assert image is not None and normal is not None
+    top, bottom = row(MIDSOLE_STRIPE[1]), row(MIDSOLE_STRIPE[0])
+    image[top:bottom] = fabrics.srgb(
+        np.broadcast_to(colour, (bottom - top, size, 3)).astype(np.float32))
+    groove = row(MIDSOLE_GROOVE)
+    image[groove - 1:groove + 2] = (image[groove - 1:groove + 2].astype(np.float32)
+                                    * 0.7).astype(np.uint8)  # fmt: skip
+    normal[groove - 2:groove] = (128, 90, 235)  # the groove's walls face up and down
+    normal[groove + 1:groove + 3] = (128, 166, 235)
 
 
 # ---------------------------------------------------------------------------- helpers
