@@ -93,7 +93,7 @@ HEAD_SETS = ("heads", "hair", "looks5", "facial")
 CROWN_AIM = 1.8 - 0.32  # tops: crowns put at 1.8 m (as heads), the camera on the shoulders
 # set -> (metres between bodies, frame height / width per body, aim height (m))
 FRAMING = {"legs": (0.6, 2.2, 0.62), "tops": (0.55, 1.25, CROWN_AIM),
-           "facial": (0.22, 1.0, 1.8 - 0.2), "jacket": (0.75, 1.1, 1.27),
+           "facial": (0.22, 1.0, 1.8 - 0.2), "jacket": (0.75, 1.2, 1.2),
            "shoes6": (0.42, 0.5, 0.07)}  # fmt: skip
 # Per set: where the camera looks (z of the aim point relative to the aligned height, m),
 # and the views (name -> direction from subject to camera).
