@@ -186,8 +186,23 @@ def test_long_hair_lies_on_the_scalp_over_the_head(body):
     v = hair.long_cards(body).mesh.vertices
     top = v[v[:, 2] > eye_z + 0.02]
     height = collision.query(body.vertices[:13380], surface, top).distance
-    assert len(top) > 1000
+    assert len(top) > 500
     assert np.median(height) < 0.006 and np.percentile(height, 90) < 0.012
+
+
+def test_long_hair_roots_do_not_stack_up_at_the_crown(body):
+    """The long locks' roots spread round the back of the head under the hair grown over
+    it, not all at the crown where MakeHuman's hair ribbons begin: 298 of the 360 locks
+    started within a centimetre of one another there, a stack of card edges that rendered
+    as a dark band along the top of long hair."""
+    from scipy.spatial import cKDTree
+
+    _, eye_z = hair.head_frame(body)
+    cards = hair.long_cards(body).mesh.vertices.reshape(-1, 2, 10, 3).mean(axis=1)
+    roots = cards[:, 0].astype(np.float64)
+    crowded = max(len(near) for near in cKDTree(roots).query_ball_point(roots, 0.01))
+    assert crowded < 0.3 * len(roots), crowded
+    assert roots[:, 2].max() < eye_z + 0.07  # under the grown hair (it covers the crown)
 
 
 @pytest.mark.parametrize("name", ["hair-bob", "hair-long", "hair-ponytail"])

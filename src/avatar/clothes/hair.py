@@ -396,6 +396,19 @@ def guides(body: AuthoringBody, samples: int = 16, behind: bool = True,
     return out[np.argsort(np.arctan2(out[:, -1, 0], out[:, -1, 1] - centre[1]))]
 
 
+# Long locks start this far above eye level (m), under the hair grown over the head: from
+# the crown, where MakeHuman's hair ribbons all begin, 360 locks' roots stacked up into a
+# ridge of card edges a few millimetres high, a dark band along the top of the head.
+LONG_ROOTS_M = 0.05
+
+
+def _start_below(path: np.ndarray, height: float) -> np.ndarray:
+    """(N, K, 3) paths resampled evenly from where each first comes down to ``height``
+    (its root when it starts lower) to its end."""
+    flipped = path[:, ::-1] * np.array([1.0, 1.0, -1.0])
+    return (_cut_at(flipped, np.full(len(path), -height)) * np.array([1.0, 1.0, -1.0]))[:, ::-1]
+
+
 def _onto_the_scalp(body: AuthoringBody, curves: np.ndarray, lift: float = 0.004) -> np.ndarray:
     """(G, K, 3) guide curves laid down onto the scalp over the head (at most ``lift`` m
     off it above eye level, freed over the 6 cm below): MakeHuman's hair ribbons stand
@@ -465,14 +478,18 @@ def long_cards(
     k = path.shape[1]
     # Shorter cards end higher up: sample each path to a random fraction of its length.
     path = _shorten(path, rng.uniform(0.75, 1.0, count))
+    _, eye_z = head_frame(body)
+    path = _start_below(path, eye_z + LONG_ROOTS_M)
     t = np.linspace(0, 1, k)[None, :, None]
     # Lying on the scalp over the head (under the cards grown there), the layers lifting
     # from eye level down over 6 cm: rising from the crown as the square root of their
     # length, the locks' roots stood a centimetre or two off the top of the head, a dark
     # ridge of wide cards across it.
-    _, eye_z = head_frame(body)
     below = np.clip((eye_z - path[..., 2:]) / 0.06, 0, 1)
     height = rng.uniform(layers[0], layers[1], count)[:, None, None] * below * np.sqrt(t)
+    # Over the head each lock at its own height, up to 2 mm apart: laid at one height on
+    # the scalp, the locks met there in one surface and shaded one another black.
+    height = height + rng.uniform(0, 0.002, count)[:, None, None] * (1 - below)
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
@@ -480,7 +497,10 @@ def long_cards(
     along /= np.maximum(np.linalg.norm(along, axis=-1, keepdims=True), 1e-9)
     sideways = np.cross(along, normal)
     path = path + rng.normal(0, 0.006, (count, 1, 1)) * t**1.5 * sideways  # wandering locks
-    turn = rng.uniform(-0.45, 0.45, count)[:, None, None]
+    # Turned about their paths where they hang, flat on the scalp over the head (a lock
+    # 2.4 cm wide turned 26 degrees there cut into the scalp by an edge and stood up by
+    # the other).
+    turn = rng.uniform(-0.45, 0.45, count)[:, None, None] * below
     facing = np.cos(turn) * normal + np.sin(turn) * sideways
     return _card_piece(body, path, facing, width, rng)
 
