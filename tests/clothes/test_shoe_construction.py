@@ -115,8 +115,8 @@ def test_sneakers_have_a_deep_light_midsole_a_toe_bumper_and_a_heel_tab(body, bu
 
     shoe_ball, shoe_tread, _ = sole_edge("shoes")
     sneaker_ball, sneaker_tread, bumper = sole_edge("sneakers")
-    assert shoe_ball < 0.018 and sneaker_ball > 0.025  # a midsole ~3 cm tall at the ball
-    assert foot.ground - sneaker_tread > 0.013  # 13+ mm of rubber under the foot
+    assert shoe_ball < 0.018 and sneaker_ball > 0.02  # a midsole over 2 cm tall at the ball
+    assert foot.ground - sneaker_tread > 0.01  # 10+ mm of rubber under the foot
     assert bumper > 0.008  # the sole wraps up round the toe
     # White midsole, lighter than the grey canvas upper; a navy band moulded round it.
     image = built["sneakers"].material.base_color_texture

@@ -667,7 +667,7 @@ SPECS = [
     Spec("socks", "legwear", lambda b: _tights(b, socks, 0.0015), "knit", "white", 0.0015, 20, ("socks",)),  # noqa: E501
     Spec("shoes", "footwear", shoes.shoes, "leather", "brown", 0.0025, 30, ("shoes", "leather", "laced"), look=shoes.look("calf", "brown", "sole", "sole brown")),  # noqa: E501
     Spec("shoes-black", "footwear", shoes.shoes, "leather", "black", 0.0025, 30, ("shoes", "formal", "laced"), look=shoes.look("calf", "black", "sole", "sole black")),  # noqa: E501
-    Spec("sneakers", "footwear", shoes.sneakers, "canvas", "light grey", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoes.look("canvas", "light grey", "rubber", "white", cap_colour="grey", trim=("canvas", "navy"), band="navy")),  # noqa: E501
+    Spec("sneakers", "footwear", shoes.sneakers, "canvas", "light grey", 0.0025, 30, ("sneakers", "trainers", "children", "sport"), look=shoes.look("cotton", "light grey", "rubber", "white", cap_colour="grey", trim=("cotton", "navy"), band="navy")),  # noqa: E501
     Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoes.look("calf", "dark brown", "sole", "sole black")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.0, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501

@@ -250,8 +250,8 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
         z = band + 0.09
         centre = np.array([inner(z) + 0.5 * (outer(z) - inner(z)) + 0.01, z])
         out += _welt(panels, k, centre, 0.14, 0.022, -0.2)
-        if PANELS[k].side > 0:  # the chest pocket, wearer's left
-            z = marks.chest_z + 0.03
+        if PANELS[k].side > 0:  # the chest pocket, wearer's left, a hand below the shoulder
+            z = marks.shoulder[0, 2] - 0.13
             centre = np.array([inner(z) + 0.075, z])
             out += _welt(panels, k, centre, 0.1, 0.016, 0.12)
     for k in SLEEVES:  # cuffs: a band 5 cm deep at the wrist, topstitched; the underarm seam

@@ -79,10 +79,11 @@ class Style:
 
 
 SHOE = Style()
-# A sneaker: a 15 mm rubber midsole under the foot rising 11 mm up the upper (its edge
-# ~3 cm tall at the ball, against a leather shoe's ~1 cm), 2.4 cm at the heel, wrapping
-# 1.3 cm further up round the toe (the toe bumper); contrasting facings and a heel tab.
-SNEAKER = Style(under=0.015, cover=0.011, heel=0.024, welt=0.0035, bumper=0.013,
+# A sneaker: a 12 mm rubber midsole under the foot rising 7 mm up the upper (its edge
+# ~2.3 cm tall at the ball, against a leather shoe's ~1 cm), 2 cm at the heel, wrapping
+# a centimetre further up round the toe (the toe bumper); contrasting facings, heel tab.
+# (15 mm rising 11 mm read as an orthopaedic platform.)
+SNEAKER = Style(under=0.012, cover=0.007, heel=0.02, welt=0.003, bumper=0.01,
                 heel_tab=True, facings="trim")  # fmt: skip
 
 
@@ -333,8 +334,10 @@ def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot,
 
 # Heights (m) over the upper's surface of the lacing's layers: the tongue, the quarters'
 # facings on it, eyelets in the facings, the lace through them (its crown a little higher
-# again, and higher still where it crosses over the one before).
-TONGUE_LIFT, FACING_LIFT, EYELET_LIFT, LACE_LIFT = 0.0005, 0.0011, 0.0015, 0.0019
+# again, and higher still where it crosses over the one before). Each layer is bound to
+# the body on its own: on other bodies than the authoring one a layer 0.6 mm over the one
+# under it sank into it in patches (navy facings as blotches on a sneaker).
+TONGUE_LIFT, FACING_LIFT, EYELET_LIFT, LACE_LIFT = 0.001, 0.002, 0.0026, 0.0032
 LACE_WIDTH = 0.0035
 LACE_ROWS = (0.72, 0.47)  # along the foot: the lowest eyelets (towards the toes), the top
 
