@@ -171,8 +171,33 @@ def test_bob_falls_clear_of_the_ears(body):
     ears = (lines[..., 2] > eye_z - 0.05) & (lines[..., 2] < eye_z + 0.03)
     widest = np.maximum.accumulate(np.where(ears, radius, -np.inf), axis=1)
     dip = np.where(ears, widest - radius, 0.0).max(axis=1)
-    assert (dip > 0.003).mean() < 0.05, (dip > 0.003).mean()
-    assert dip.max() < 0.006, dip.max()
+    assert (dip > 0.003).mean() < 0.06, (dip > 0.003).mean()
+    assert dip.max() < 0.0075, dip.max()
+
+
+def test_bob_has_no_lone_locks_over_the_ears(body):
+    """At ear level no card of the bob stands far out from the hair around it (within
+    1.2 cm over the head's surface): the cards passing over an ear stood up to 3.6 cm
+    out from those just in front of and behind it, a loop seen from the front."""
+    from scipy.spatial import cKDTree
+
+    centre, eye_z = hair.head_frame(body)
+    lines = hair.hang_cards(body, hair.flow_parted()).mesh.vertices.reshape(-1, 2, 11, 3)
+    points = lines.mean(axis=1).astype(np.float64).reshape(-1, 3)
+    card = np.repeat(np.arange(len(lines)), 11)
+    rel = points[:, :2] - centre[:2]
+    radius = np.linalg.norm(rel, axis=1)
+    where = np.stack([np.arctan2(rel[:, 0], -rel[:, 1]) * 0.1, points[:, 2]], 1)
+    ears = np.flatnonzero((points[:, 2] > eye_z - 0.05) & (points[:, 2] < eye_z + 0.03)
+                          & (np.abs(points[:, 0]) > 0.05))  # fmt: skip
+    tree = cKDTree(where)
+    out = np.zeros(len(lines))
+    for i, near in zip(ears, tree.query_ball_point(where[ears], 0.012), strict=True):
+        others = [j for j in near if card[j] != card[i]]
+        if len(others) > 5:
+            out[card[i]] = max(out[card[i]], radius[i] - np.median(radius[others]))
+    assert len(ears) > 500
+    assert np.percentile(out, 99) < 0.015 and out.max() < 0.02, (np.percentile(out, 99), out.max())
 
 
 def test_long_hair_lies_on_the_scalp_over_the_head(body):

@@ -655,6 +655,7 @@ def hang_cards(
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
+    path = _fall_clear(_no_lone_locks(path, centre, eye_z + 0.03), centre, eye_z + 0.03)
     stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
     path = _curl_in(body, _cut_at(path, stop), centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
@@ -678,6 +679,33 @@ def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarra
     out = path.copy()
     out[..., :2] = centre[:2] + rel * scale[..., None]
     return out
+
+
+def _no_lone_locks(path: np.ndarray, centre: np.ndarray, below: float,
+                   lean: float = 0.5, slack: float = 0.008) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) hanging paths pushed out from the head's vertical axis (through
+    ``centre``), below the height ``below``, so that none stands out from the hair around
+    it: each point at least as far out as every neighbour within 3 cm (over the head's
+    surface: arc round it at 10 cm, height), less ``lean`` times their distance and
+    ``slack`` m. The cards that pass over an ear stood 2-3.5 cm out from those just in
+    front of and behind it (a lone lock, a loop seen from the front); now the hair
+    around the ear is pushed out with them, one smooth curtain."""
+    from scipy.spatial import cKDTree
+
+    flat = path.reshape(-1, 3)
+    rel = flat[:, :2] - centre[:2]
+    radius = np.linalg.norm(rel, axis=1)
+    where = np.stack([np.arctan2(rel[:, 0], -rel[:, 1]) * 0.1, flat[:, 2]], 1)
+    hanging = np.flatnonzero(flat[:, 2] < below)
+    pairs = cKDTree(where[hanging]).query_pairs(0.03, output_type="ndarray")
+    a, b = hanging[pairs[:, 0]], hanging[pairs[:, 1]]
+    apart = np.linalg.norm(where[a] - where[b], axis=1)
+    need = radius.copy()
+    np.maximum.at(need, a, radius[b] - lean * apart - slack)
+    np.maximum.at(need, b, radius[a] - lean * apart - slack)
+    out = flat.copy()
+    out[:, :2] = centre[:2] + rel * (need / np.maximum(radius, 1e-9))[:, None]
+    return out.reshape(path.shape)
 
 
 def _layers(path: np.ndarray, centre: np.ndarray, free: np.ndarray, rng) -> np.ndarray:
