@@ -11,9 +11,10 @@ Two renders of one staged scene:
 
 from __future__ import annotations
 
+import contextlib
 import math
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +32,9 @@ from avatar.part import MeshPart
 
 PART_ATTRIBUTE = "avatar_part"
 PART_AOV = "part"
+# Uncompressed: the file lives a moment in a temp dir; ZIP spent ~20 ms a pass compressing
+# float32 noise (normals) that the reader then inflates again. Lossless either way.
+LABEL_EXR_CODEC = "NONE"
 NO_HIT = 1e9  # m: Cycles' depth where a ray hits nothing is far beyond this
 _FLOOR = Mesh(np.array([[-20, -20, 0], [20, -20, 0], [20, 20, 0], [-20, 20, 0]], np.float32),
               np.array([[0, 1, 2, 3]], np.int32))  # fmt: skip
@@ -161,8 +165,8 @@ class Stage:
             settings.media_type = "MULTI_LAYER_IMAGE"
         settings.file_format = "OPEN_EXR_MULTILAYER"
         settings.color_depth = "32"
-        settings.exr_codec = "ZIP"
-        with tempfile.TemporaryDirectory(prefix="avatar-labels-") as tmp:
+        settings.exr_codec = LABEL_EXR_CODEC
+        with _unlit(scene), tempfile.TemporaryDirectory(prefix="avatar-labels-") as tmp:
             path = Path(tmp) / "labels.exr"
             scene.render.filepath = str(path)
             bpy.ops.render.render(write_still=True)
@@ -172,6 +176,28 @@ class Stage:
             settings.media_type = "IMAGE"
         settings.file_format = "PNG"
         return _labels(channels)
+
+
+@contextlib.contextmanager
+def _unlit(scene: bpy.types.Scene) -> Iterator[None]:
+    """The scene without its world and lights for the label render, restored after.
+
+    No label depends on light (depth, normals, ids and the AOV are what the camera ray hits,
+    and the film is transparent), but Cycles would still prepare it: Blender's sky texture
+    precomputes its multiple scattering table on every render (~0.7 s of a 1-sample pass
+    at 256x256), the world's importance map, the light tree and one shadow ray per light
+    for every pixel."""
+    world = scene.world
+    lights = [obj for obj in scene.objects if obj.type == "LIGHT" and not obj.hide_render]
+    scene.world = None
+    for obj in lights:
+        obj.hide_render = True
+    try:
+        yield
+    finally:
+        scene.world = world
+        for obj in lights:
+            obj.hide_render = False
 
 
 def _clear_objects() -> None:
