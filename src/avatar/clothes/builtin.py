@@ -329,7 +329,16 @@ DRESS_OVER = DRESS_THICKNESS + 0.0025
 # bodice's cloth, so the bodice's surface runs on into the skirt's as across a sewn
 # waist seam (at 2.5 mm the skirt's edge stood 3-6 mm proud of the bodice, a ledge).
 DRESS_SEAM = 0.0015
-dress_bodice = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
+_dress_bodice_back = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
+_dress_bodice_front = strapped(0.07, armhole=0.056, front=0.09, back=0.07)
+
+
+def dress_bodice(ff, m):
+    """The dress's bodice, 3 cm longer in front: the skirt's top dips 2 cm lower there than
+    at the sides, and a bodice cut level with the back ran level with it, its hem at the
+    skirt's edge 4-6 cm either side of the middle (two dark slits between the layers)."""
+    front = ff.centre[:, 1] < m.hip[0, 1]
+    return _dress_bodice_back(ff, m) | (_dress_bodice_front(ff, m) & front)
 
 
 def _dress(body: AuthoringBody) -> Piece:
