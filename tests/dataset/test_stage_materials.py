@@ -76,3 +76,19 @@ def test_least_recently_used_materials_are_dropped_with_their_images():
     assert stage.names() == {names[2], stage.get(parts[0]).name_full}
     stage.clear()
     assert len(bpy.data.images) == images_before
+
+
+def test_equal_records_share_a_material_that_outlives_either_entry():
+    from dataclasses import replace
+
+    from avatar.blender.stage_materials import StageMaterials
+
+    stage = StageMaterials(keep=1)
+    stage.for_picture(128, 128)
+    first = _part("twin", side=256, seed=7)
+    second = replace(first, material=replace(first.material))  # equal content, another record
+    shared = stage.get(first)
+    assert stage.get(second) is shared  # the bridge's digest finds the first one
+    stage.trim(used=set())  # drops the first entry; the second still holds the material
+    assert shared.name_full in stage.names() and len(shared.node_tree.nodes) > 0
+    stage.clear()

@@ -25,6 +25,7 @@ from avatar.blender import materials as material_bridge
 from avatar.blender import mesh as mesh_bridge
 from avatar.blender import render as render_bridge
 from avatar.blender.camera import add_camera
+from avatar.blender.stage_materials import StageMaterials
 from avatar.camera import CameraModel
 from avatar.io import exr
 from avatar.mesh import Mesh
@@ -67,10 +68,11 @@ class Labels:
 
 class Stage:
     """A worker's Blender scene, reused sample after sample: materials and images made once
-    per material record and dropped when no longer used, objects replaced every sample."""
+    per material record with maps sized for the picture and kept while recently used
+    (``StageMaterials``), objects replaced every sample."""
 
     def __init__(self) -> None:
-        self.materials: dict[int, tuple[object, bpy.types.Material]] = {}
+        self.materials = StageMaterials()
         self.label_material = _label_material()
         self.floor_material = material_bridge.plain("Floor", (0.55, 0.55, 0.53), roughness=0.9)
         self.floor_material.use_fake_user = True
@@ -80,10 +82,11 @@ class Stage:
         """Replace the scene's objects by ``items``, the camera, the light and the world."""
         _clear_objects()
         scene = bpy.context.scene
+        self.materials.for_picture(*camera.size)
         used: set[str] = set()
         for item in items:
             obj = mesh_bridge.new_mesh_object(item.part.name, item.part.mesh, scene.collection)
-            mat = self._material(item.part)
+            mat = self.materials.get(item.part)
             obj.data.materials.append(mat)
             used.add(mat.name_full)
             obj.pass_index = int(item.instance)
@@ -100,21 +103,11 @@ class Stage:
         _add_light(scene, light)
         _set_world(scene, background, light if light.get("kind") == "sky" else None)
 
-    def _material(self, part: MeshPart) -> bpy.types.Material:
-        key = id(part.material)
-        if key not in self.materials:
-            # keep the record alive with its material: its id() is not reused meanwhile
-            self.materials[key] = (part.material, material_bridge.material(part.material,
-                                                                           part.name))
-        return self.materials[key][1]
-
     def _drop_unused(self, used: set[str]) -> None:
-        """Forget records whose material this sample did not use and remove those materials
-        (and their images) from Blender; the bridge may give equal records one material."""
-        for key in list(self.materials):
-            if self.materials[key][1].name_full not in used:
-                del self.materials[key]
-        kept = {mat.name_full for _, mat in self.materials.values()}
+        """Keep the stage's recently used materials (``StageMaterials.trim``) and remove any
+        other material no object uses, with its images (e.g. from an EEVEE/Workbench run)."""
+        self.materials.trim(used)
+        kept = self.materials.names()
         for mat in list(bpy.data.materials):
             if mat.users == 0 and mat.name_full not in kept and not mat.use_fake_user:
                 images = [n.image for n in mat.node_tree.nodes if getattr(n, "image", None)]
@@ -166,7 +159,8 @@ class Stage:
         settings.file_format = "OPEN_EXR_MULTILAYER"
         settings.color_depth = "32"
         settings.exr_codec = LABEL_EXR_CODEC
-        with _unlit(scene), tempfile.TemporaryDirectory(prefix="avatar-labels-") as tmp:
+        with _unlit(scene), _only_material(scene, self.label_material), \
+                tempfile.TemporaryDirectory(prefix="avatar-labels-") as tmp:
             path = Path(tmp) / "labels.exr"
             scene.render.filepath = str(path)
             bpy.ops.render.render(write_still=True)
@@ -198,6 +192,24 @@ def _unlit(scene: bpy.types.Scene) -> Iterator[None]:
         scene.world = world
         for obj in lights:
             obj.hide_render = False
+
+
+@contextlib.contextmanager
+def _only_material(scene: bpy.types.Scene, material: bpy.types.Material) -> Iterator[None]:
+    """Every mesh's material slots hold ``material`` for the label render, restored after.
+
+    The view layer's material override alone makes Cycles shade with it, but the meshes'
+    own materials stay in the depsgraph: Cycles still synced them and loaded every texture
+    (skin, garments, hair: ~20-90 ms a pass) for a render that never samples them."""
+    slots = [(obj.data, i, mat) for obj in scene.objects if obj.type == "MESH"
+             for i, mat in enumerate(obj.data.materials)]  # fmt: skip
+    for mesh, i, _ in slots:
+        mesh.materials[i] = material
+    try:
+        yield
+    finally:
+        for mesh, i, mat in slots:
+            mesh.materials[i] = mat
 
 
 def _clear_objects() -> None:

@@ -89,12 +89,14 @@ class StageMaterials:
             if mat.name_full in used:
                 break
             del self._cache[key]
-            _remove(mat)
+            if mat.name_full not in self.names():  # equal records share one material
+                _remove(mat)
 
     def clear(self) -> None:
-        for _, mat in list(self._cache.values()):
-            _remove(mat)
+        materials = {mat.name_full: mat for _, mat in self._cache.values()}
         self._cache.clear()
+        for mat in materials.values():
+            _remove(mat)
 
     def names(self) -> set[str]:
         return {mat.name_full for _, mat in self._cache.values()}
