@@ -44,10 +44,11 @@ def _staged(light: dict, background: dict):
 
 @pytest.mark.parametrize("light", [{"kind": "sky", "elevation_deg": 30.0}, {"kind": "area"}])
 def test_labels_render_without_world_or_lights_and_equal_a_lit_render(light, monkeypatch):
-    """Nothing the label render writes depends on light, so it renders without the world
-    (Blender's sky texture rebuilt its scattering table on every label render: ~0.7 s of a
-    0.3 s pass) and without lights; the scene gets both back, and its labels equal those of
-    the same render with the world and lights in."""
+    """Nothing the label render writes depends on light or the scene's own materials, so it
+    renders without the world (Blender's sky texture rebuilt its scattering table on every
+    label render: ~0.7 s) and lights, and with the label material in every slot (with the
+    override alone Cycles still loaded every texture); the scene gets all of it back, and its
+    labels equal those of the same render with the world, lights and materials in."""
     from avatar.blender import labels
 
     bpy = labels.bpy  # Blender through the bridge (tests do not import it themselves)
@@ -56,21 +57,27 @@ def test_labels_render_without_world_or_lights_and_equal_a_lit_render(light, mon
     world = scene.world
     lamps = [obj for obj in scene.objects if obj.type == "LIGHT"]
     assert world is not None and len(lamps) == 1
+    meshes = [obj.data for obj in scene.objects if obj.type == "MESH"]
+    own = [list(mesh.materials) for mesh in meshes]
+    assert len(meshes) == 3 and stage.label_material not in sum(own, [])  # boxes and floor
     seen = []
 
     def during(*_args) -> None:
         s = bpy.context.scene
-        seen.append((s.world, [o.hide_render for o in lamps], s.render.image_settings.exr_codec))
+        seen.append((s.world, [o.hide_render for o in lamps], s.render.image_settings.exr_codec,
+                     {m.name for mesh in meshes for m in mesh.materials}))
 
     bpy.app.handlers.render_pre.append(during)
     try:
         unlit = stage.render_labels()
     finally:
         bpy.app.handlers.render_pre.remove(during)
-    assert seen == [(None, [True], "NONE")]
+    assert seen == [(None, [True], "NONE", {stage.label_material.name})]
     assert scene.world == world and not lamps[0].hide_render
+    assert [list(mesh.materials) for mesh in meshes] == own
 
     monkeypatch.setattr(labels, "_unlit", lambda scene: contextlib.nullcontext())
+    monkeypatch.setattr(labels, "_only_material", lambda scene, mat: contextlib.nullcontext())
     lit = stage.render_labels()
     for name in ("depth", "normals", "instance", "part"):
         assert np.array_equal(getattr(unlit, name), getattr(lit, name)), name
