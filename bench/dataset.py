@@ -1,10 +1,11 @@
 """Dataset throughput and memory, against anchors measured in the same run.
 
     python bench/dataset.py [--count 16] [--resolution 256] [--samples 16] [--rss 0]
-                            [--repeat 1]
+                            [--repeat 1] [--overhead-only]
 
 1. label overhead: samples/s with every label against the anchor, a bare Cycles render of
-   the same scenes (same people, camera, lights; RGB only), on one worker in-process;
+   the same scenes (same people, camera, lights; RGB only), on one worker in-process, and
+   the label pass's own seconds (``--overhead-only``: this part alone);
 2. workers: 1 -> 2 local worker processes, each rendering on its share of the cores
    (efficiency = rate(2) / (2 * rate(1)), the single worker on one core's share, as each
    of the two has: its threads limited and the process held to that many cores), and the
@@ -41,15 +42,26 @@ def _config(args, count: int, extra: str = "") -> dataset_config.Config:
                                 resolution=(args.resolution, args.resolution))  # fmt: skip
 
 
-def bare_vs_labelled(args, folder: Path) -> tuple[float, float, float]:
-    """(bare s/sample, labelled s/sample, median over the samples of labelled / bare) in
-    this process, same scenes, alternating (the median of the pairs is not thrown by one
-    sample that met a busy host)."""
+def bare_vs_labelled(args, folder: Path) -> tuple[float, float, float, float]:
+    """(bare s/sample, labelled s/sample, median over the samples of labelled / bare, mean
+    s of ``Stage.render_labels``) in this process, same scenes, alternating (the median of
+    the pairs is not thrown by one sample that met a busy host)."""
     from avatar.blender import labels as blender_labels
 
     c = _config(args, args.count)
     bare, labelled = np.zeros(args.count), np.zeros(args.count)
     worker.render_sample(c, args.count, folder)  # warm: garments built, Blender started
+    label_pass: list[float] = []
+    render_labels = blender_labels.Stage.render_labels
+
+    def timed(stage):  # the label render, read back and decoded
+        start = time.perf_counter()
+        try:
+            return render_labels(stage)
+        finally:
+            label_pass.append(time.perf_counter() - start)
+
+    blender_labels.Stage.render_labels = timed  # type: ignore[method-assign]
     for i in range(args.count):
         for step in ((0, 1) if i % 2 else (1, 0)):  # alternate which one meets warm caches
             start = time.perf_counter()
@@ -64,7 +76,9 @@ def bare_vs_labelled(args, folder: Path) -> tuple[float, float, float]:
             stage.build(items, spec.camera, spec.light, spec.background)
             stage.render_rgb(folder / "bare.png", spec.engine, spec.samples, False)
             bare[i] = time.perf_counter() - start
-    return bare.mean(), labelled.mean(), float(np.median(labelled / bare))
+    blender_labels.Stage.render_labels = render_labels  # type: ignore[method-assign]
+    paired = float(np.median(labelled / bare))
+    return bare.mean(), labelled.mean(), paired, float(np.mean(label_pass))
 
 
 def rate(args, workers: int, engine: str, folder: Path,
@@ -159,6 +173,8 @@ def main() -> int:
     parser.add_argument("--rss", type=int, default=0, help="samples for the memory curve")
     parser.add_argument("--skip-ray", action="store_true")
     parser.add_argument("--repeat", type=int, default=1, help="rounds of the workers' rates")
+    parser.add_argument("--overhead-only", action="store_true",
+                        help="only the label overhead (part 1)")
     args = parser.parse_args()
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
     with tempfile.TemporaryDirectory() as tmp:
@@ -183,10 +199,13 @@ def main() -> int:
 
 
 def _throughput(args, root: Path) -> None:
-    bare, labelled, paired = bare_vs_labelled(args, root / "inproc")
+    bare, labelled, paired, label_pass = bare_vs_labelled(args, root / "inproc")
     print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
           f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}% "
-          f"(median of the {args.count} pairs: {100 * (paired - 1):.0f}%)")  # fmt: skip
+          f"(median of the {args.count} pairs: {100 * (paired - 1):.0f}%); the label pass "
+          f"itself {label_pass:.3f} s/sample")  # fmt: skip
+    if args.overhead_only:
+        return
     share = max(1, (os.cpu_count() or 1) // 2)
     rounds = []
     for r in range(args.repeat):
