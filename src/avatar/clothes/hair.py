@@ -182,6 +182,7 @@ def grow_cards(
     lift=(0.004, 0.014),
     segments: int = 2,
     seed: int = 0,
+    root: float = 0.0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
 
@@ -197,6 +198,11 @@ def grow_cards(
     (~9,300 vertices with the base cap, within a game character's 10,000): a 4 cm card
     bends over the skull by half a millimetre between its ends, which four segments
     (15,300 vertices) did not make visible, but the per-frame cost of posing them showed.
+
+    ``root``: m above the skin the cards' roots stand (0: on it, under the base cap); a
+    card then never rises below it. A buzz cut's cards lie over the cap all their length:
+    rooted on the skin they came up through the cap half-way along, and each card's cut
+    through it drew the outline of a scale.
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
@@ -207,8 +213,12 @@ def grow_cards(
     crown = centre + np.asarray(CROWN_OFFSET)
     top *= 0.5 + 0.5 * np.clip(np.linalg.norm(roots - crown, axis=1) / 0.07, 0, 1)
     top *= rng.uniform(0.55, 1.0, count)
+    top = np.maximum(top, root)
+    start = max(root, 0.002)
     # Short at the hairline (a fringe would hang over the face), full length further in.
     size = rng.uniform(length[0], length[1], count) * (0.45 + 0.55 * np.clip(depth / 0.04, 0, 1))
+    if root > 0:
+        roots = _above_skin(body, roots, np.full(len(roots), root))
     rows = [roots]
     point = roots
     for k in range(1, segments + 1):
@@ -216,7 +226,7 @@ def grow_cards(
         # Rising evenly along the card (lying down from the root), not steeply at first:
         # a card whose first half rose at 15-25 degrees stood up from the scalp.
         point = _above_skin(body, point + step * (size / segments)[:, None],
-                            0.002 + (top - 0.002) * (k / segments))  # fmt: skip
+                            start + (top - start) * (k / segments))  # fmt: skip
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)

@@ -1,0 +1,52 @@
+"""The buzz cut reads as short stubble lying on the scalp, not as flat scales (issue 14):
+measured on the built cards on the authoring body."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope="module")
+def buzz():
+    from avatar.clothes import builtin, hair, library
+
+    body = library.authoring_body()
+    piece = builtin.BY_NAME["hair-buzz"].make(body)
+    cap = len(hair.base_cap(body, CAP).mesh.vertices)  # joined first, the cards after
+    return body, piece.mesh.vertices[cap:].astype(np.float64), piece.mesh.faces
+
+
+CAP = 0.0015  # m: the buzz cut's base cap off the skin
+
+
+def _height_off_skin(body, points: np.ndarray) -> np.ndarray:
+    """(N,) m of points (N, 3) above the skin along the nearest skin vertex's normal."""
+    _, i = body.skin_tree.query(points)
+    return np.einsum("nd,nd->n", points - body.vertices[i], body.skin_normals[i])
+
+
+def test_buzz_cards_lie_over_the_cap_from_root_to_tip(buzz):
+    """Rooted on the skin, the cards came up through the base cap (1.5 mm off the skin)
+    half-way along: each card's cut through it drew the outline of a scale. Now all but a
+    few vertices (a card's edge over a hollow, at the nape) lie above the cap, half of
+    them 0.5 to 1.5 mm above it."""
+    body, cards, _ = buzz
+    height = _height_off_skin(body, cards)
+    assert np.percentile(height, 2) > CAP + 0.0001, np.percentile(height, [0, 2, 50])
+    assert CAP + 0.0005 < np.median(height) < CAP + 0.0015, np.median(height)
+
+
+def test_buzz_cards_are_narrow(buzz):
+    """8 mm wide cards (6.4 mm at the median, root and tip) read as flat scales from the
+    side; a buzz cut's are 3-5 mm across."""
+    _, cards, faces = buzz
+    # A card's vertices are its left edge, root to tip, then its right edge: an edge
+    # across the card joins two vertices a whole edge apart, one along it neighbours.
+    start = faces.max() + 1 - len(cards)
+    own = faces[faces.min(axis=1) >= start] - start
+    a, b = own.ravel(), np.roll(own, -1, axis=1).ravel()
+    across = np.abs(a - b) > 1
+    width = np.linalg.norm(cards[a[across]] - cards[b[across]], axis=1)
+    assert np.median(width) < 0.005, np.median(width)
+    assert np.median(width) > 0.003, np.median(width)
