@@ -92,3 +92,53 @@ def test_equal_records_share_a_material_that_outlives_either_entry():
     stage.trim(used=set())  # drops the first entry; the second still holds the material
     assert shared.name_full in stage.names() and len(shared.node_tree.nodes) > 0
     stage.clear()
+
+
+def test_cache_stays_bounded_when_an_old_entry_shares_a_material_in_use():
+    """Records equal in content but with their own arrays (a garment rebuilt for each body)
+    share one Blender material; the oldest entry holding it must not stop the trimming
+    (it did: 264 cached materials after 60 samples with keep = 32)."""
+    import gc
+
+    from avatar.blender.stage_materials import StageMaterials
+
+    bpy = pytest.importorskip("bpy")
+    stage = StageMaterials(keep=2)
+    stage.for_picture(128, 128)
+    base = _part("skin", side=256, seed=3)
+    parts = [base]
+    for i in range(6):
+        m = base.material
+        twin = Material("skin", base_color_texture=m.base_color_texture.copy(),
+                        roughness_texture=m.roughness_texture.copy())  # fmt: skip
+        copy = MeshPart("skin", QUAD, twin)
+        shared = stage.get(copy)
+        parts.append(copy)
+        other = _part(f"garment{i}", side=256, seed=10 + i)
+        parts.append(other)
+        stage.get(other)
+        stage.trim(used={shared.name_full, stage.get(other).name_full})
+        assert len(stage._cache) <= 2, len(stage._cache)
+        assert shared.name_full in bpy.data.materials  # in use: kept
+    del parts, base, copy, other
+    gc.collect()
+    stage.trim(used=set())  # every record is gone: nothing can be hit, nothing is kept
+    assert stage.names() == set()
+    stage.clear()
+
+
+def test_the_cache_holds_no_texture_alive():
+    import gc
+    import weakref
+
+    from avatar.blender.stage_materials import StageMaterials
+
+    stage = StageMaterials(keep=8)
+    stage.for_picture(128, 128)
+    part = _part("shirt", side=512, seed=5)
+    stage.get(part)
+    texture = weakref.ref(part.material.base_color_texture)
+    del part
+    gc.collect()
+    assert texture() is None
+    stage.clear()

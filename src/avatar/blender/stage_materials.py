@@ -13,6 +13,7 @@ on any texture (the label pass overrides every material).
 
 from __future__ import annotations
 
+import weakref
 from collections import OrderedDict
 from dataclasses import replace
 from typing import Any
@@ -50,14 +51,16 @@ def sized(material: Material, side: int) -> Material:
 class StageMaterials:
     """Blender materials for parts' material records, made once per record and picture size.
 
-    Keyed by the record's identity (the garment library hands out the same record for the
-    same garment and colour); the record is held with its material, so its id is not reused
-    while cached."""
+    Keyed by what a record draws with: its name and factors, and its texture arrays by
+    identity (the garment library hands out the same arrays for the same garment and
+    colour, while a body's skin is new every sample). The arrays are held by weak reference
+    only, so the cache keeps no full-size map alive; an entry whose arrays are gone can never
+    be hit again and is dropped first."""
 
     def __init__(self, keep: int = KEEP) -> None:
         self.keep = keep
         self.side = 0
-        self._cache: OrderedDict[int, tuple[Material, bpy.types.Material]] = OrderedDict()
+        self._cache: OrderedDict[tuple, tuple[tuple, bpy.types.Material]] = OrderedDict()
         self.made = 0  # Blender materials made so far (for tests and benchmarks)
 
     def for_picture(self, width: int, height: int) -> None:
@@ -71,26 +74,29 @@ class StageMaterials:
     def get(self, part: MeshPart) -> bpy.types.Material:
         """The Blender material for ``part`` (made now, or the cached one)."""
         record = part.material
-        key = id(record)
-        if key in self._cache:
+        key = _key(record)
+        entry = self._cache.get(key)
+        if entry is not None and _alive(entry[0], record):
             self._cache.move_to_end(key)
-            return self._cache[key][1]
+            return entry[1]
         staged = None if record is None else sized(record, self.side or MIN_SIDE)
-        made = material_bridge.material(staged, part.name)
+        made = material_bridge.material(staged, part.name)  # an equal record's, if cached
         self.made += 1
-        self._cache[key] = (record, made)
+        self._cache.pop(key, None)
+        self._cache[key] = (_refs(record), made)
         return made
 
     def trim(self, used: set[str]) -> None:
-        """Drop the least recently used materials past ``keep`` (never one in ``used``, the
-        materials of the staged objects) and any image nothing uses any more."""
-        while len(self._cache) > self.keep:
-            key, (_, mat) = next(iter(self._cache.items()))
-            if mat.name_full in used:
-                break
-            del self._cache[key]
-            if mat.name_full not in self.names():  # equal records share one material
-                _remove(mat)
+        """Drop the entries whose arrays are gone, then the least recently used past ``keep``,
+        and remove each dropped material, with its images, once no entry and no object in
+        ``used`` (the staged objects' materials) uses it."""
+        dead = {key for key, (refs, _) in self._cache.items() if not _alive(refs)}
+        live = [key for key in self._cache if key not in dead]
+        dropped = list(dead) + live[: max(0, len(live) - self.keep)]
+        materials = [self._cache.pop(key)[1] for key in dropped]
+        kept = self.names() | used
+        for mat in {m.name_full: m for m in materials if m.name_full not in kept}.values():
+            _remove(mat)
 
     def clear(self) -> None:
         materials = {mat.name_full: mat for _, mat in self._cache.values()}
@@ -100,6 +106,33 @@ class StageMaterials:
 
     def names(self) -> set[str]:
         return {mat.name_full for _, mat in self._cache.values()}
+
+
+def _key(record: Material | None) -> tuple:
+    """What ``record`` draws with: its factors by value, its texture arrays by identity."""
+    if record is None:
+        return (None,)
+    factors = replace(record, **{field: None for field in FIELDS})
+    return (repr(factors), *(id(getattr(record, field)) for field in FIELDS))
+
+
+def _refs(record: Material | None) -> tuple:
+    """Weak references to ``record``'s texture arrays (None where it has none)."""
+    if record is None:
+        return ()
+    return tuple(None if (a := getattr(record, f)) is None else weakref.ref(a) for f in FIELDS)
+
+
+def _alive(refs: tuple, record: Material | None = None) -> bool:
+    """Whether the arrays behind ``refs`` still exist (and are ``record``'s, when given: an
+    id can be reused once its array is gone)."""
+    for i, ref in enumerate(refs):
+        array = None if ref is None else ref()
+        if ref is not None and array is None:
+            return False
+        if record is not None and array is not getattr(record, FIELDS[i]):
+            return False
+    return True
 
 
 def _remove(mat: bpy.types.Material) -> None:
