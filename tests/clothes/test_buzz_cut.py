@@ -50,3 +50,14 @@ def test_buzz_cards_are_narrow(buzz):
     width = np.linalg.norm(cards[a[across]] - cards[b[across]], axis=1)
     assert np.median(width) < 0.005, np.median(width)
     assert np.median(width) > 0.003, np.median(width)
+
+
+def test_buzz_cap_texture_is_short_hairs_not_streaks():
+    """The cap's texture (the hair layout's dense half) is short hairs of their own shade
+    along v: one shade a column from v = 0.5 to 1 drew streaks up the whole cap."""
+    from avatar.clothes.library import load_garment
+
+    tex = load_garment("hair-buzz", texture_size=256).material.base_color_texture
+    light = tex[:128, :, :3].astype(np.float64).mean(-1)  # the dense half's rows
+    along = (light.std(axis=0) / light.mean(axis=0)).mean()  # within each column
+    assert along > 0.05

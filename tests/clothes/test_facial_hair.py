@@ -368,3 +368,74 @@ def test_short_beard_covers_the_skin_where_it_grows_fully(frame):
     assert full.sum() > 1000 and edge.sum() > 100
     assert covered[full].mean() > 0.97, covered[full].mean()
     assert covered[edge].mean() < 0.8, covered[edge].mean()
+
+
+def _card_ends(piece) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) roots and (N, 3) tips of a facial hair piece's one-segment cards."""
+    mid = piece.mesh.vertices.reshape(-1, 2, 2, 3).astype(np.float64).mean(axis=1)
+    return mid[:, 0], mid[:, 1]
+
+
+def test_short_beard_is_longer_at_the_chin_than_on_the_cheeks(frame):
+    """A short beard grows longest at the front of the chin and shortest on the cheeks
+    (one length everywhere read as a felt mat): chin cards at least 1.6 times as long."""
+    body, (centre, mouth, _, chin_z) = frame
+    roots, tips = _card_ends(face.beard_cards(body))
+    length = np.linalg.norm(tips - roots, axis=1)
+    turn = face.around(roots, centre)
+    full = face.facial_hair_density(body, "beard", roots) > 0.9
+    chin = (turn < 20) & (roots[:, 2] < mouth[2] - 0.02) & (roots[:, 2] > chin_z)
+    cheek = (turn > 50) & (turn < 80) & full
+    assert chin.sum() > 50 and cheek.sum() > 100
+    assert np.median(length[chin]) > 1.6 * np.median(length[cheek])
+
+
+def test_short_beard_grows_in_clumps(frame):
+    """Neighbouring cards' tips are drawn together into clumps (gaps between them):
+    tips lie closer to their nearest neighbours than the roots do (were 1.1 times as
+    far apart, spread as evenly as the roots)."""
+    from scipy.spatial import cKDTree
+
+    body, _ = frame
+    roots, tips = _card_ends(face.beard_cards(body))
+
+    def spacing(points):
+        return cKDTree(points).query(points, k=2)[0][:, 1].mean()
+
+    assert spacing(tips) < 0.75 * spacing(roots)
+
+
+def test_short_beard_edges_break_up_into_single_hairs(frame):
+    """Over the beard's soft edges (cheek line, neck line) stray hairs: cards a hair or
+    two wide standing off the skin, where the beard thins out (density under 0.7)."""
+    body, _ = frame
+    strays = face.beard_strays(body)
+    roots, tips = _card_ends(strays)
+    v = strays.mesh.vertices.reshape(-1, 2, 2, 3).astype(np.float64)
+    width = np.linalg.norm(v[:, 1, 0] - v[:, 0, 0], axis=1)
+    grow = face.facial_hair_density(body, "beard", roots)
+    assert len(roots) > 150 and np.median(width) < 0.002
+    assert np.mean(grow < 0.7) > 0.95
+    assert len(load_garment("beard-short", texture_size=64).mesh.vertices) > len(
+        face.beard_undercoat(body).mesh.vertices) + len(face.beard_cards(body, 1950).mesh.vertices)
+
+
+def test_beard_undercoat_is_in_the_shade_of_its_clumps():
+    """The undercoat (the hair deep in the beard, seen between clumps) is darker than the
+    cards over it: as light, the beard read as one even mat."""
+    texture = load_garment("beard-short", texture_size=256).material.base_color_texture
+    shown, light = texture[..., 3] > 127, texture[..., :3].mean(-1)
+    under, cards = light[:128][shown[:128]].mean(), light[128:][shown[128:]].mean()
+    assert under < 0.75 * cards
+
+
+def test_grey_beard_greys_hair_by_hair_not_in_streaks():
+    """An old man's beard greys hair by hair in the undercoat (the dense rows): whole
+    texture columns grey drew vertical streaks down the beard and up a grey cap."""
+    from avatar.looks import facial_hair
+
+    material = load_garment("beard-short", texture_size=256).material
+    tex = facial_hair.for_wearer(material, "cards", 0.9, "dark brown hair").base_color_texture
+    grey = tex[:128, :, :3].astype(float).mean(-1) > 100
+    mixed = ~(grey.all(axis=0) | (~grey).all(axis=0))  # columns partly grey, partly not
+    assert 0.2 < grey.mean() < 0.95 and mixed.mean() > 0.5

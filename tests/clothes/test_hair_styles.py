@@ -246,3 +246,22 @@ def test_hair_worn_alone_stays_outside_fuller_faces(name):
         part = library.parts(human.outfit)[0]
         _, depth = collision.penetration(human.vertices[:13380], faces, part.mesh.vertices)
         assert depth.max() <= 0.001, f"{name} on {params}: {depth.max() * 1000:.2f} mm inside"
+
+
+def test_long_hair_is_textured_lighter_than_the_roots_inner_layers_most(body):
+    """Long locks start part way down the strand texture (lighter than its dark roots at
+    v = 0.5), the innermost layers furthest: textured from the roots and shaded by the
+    layers over them, long hair below the ears rendered darker than short hair."""
+    from avatar.clothes import hair
+
+    piece = hair.long_cards(body)
+    k = 10  # samples a lock
+    uv = piece.mesh.uvs.reshape(-1, 2 * k, 2)
+    root_v, tip_v = uv[:, 0, 1], uv[:, k - 1, 1]
+    assert np.all(root_v <= 0.41) and np.all(tip_v < 0.01)
+    assert np.percentile(root_v, 10) < 0.33 < 0.37 < np.percentile(root_v, 90)
+    # Inner locks (nearer the guides, which lie on the skin) start lighter.
+    verts = piece.mesh.vertices.reshape(-1, 2 * k, 3).astype(np.float64)
+    tip = verts[:, k - 1]
+    gap, _ = body.skin_tree.query(tip)
+    assert np.corrcoef(gap, root_v)[0, 1] > 0.3

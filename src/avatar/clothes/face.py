@@ -309,15 +309,19 @@ def _beard_flow(centre: np.ndarray):
     return flow
 
 
-def beard(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:
+def beard(body: AuthoringBody, count: int = 1800, length=(0.007, 0.013)) -> Piece:
     """A short full beard: a dense undercoat of hair on the skin where it grows
     (``beard_undercoat``) under strand cards combed down the face (``beard_cards``).
 
     Cards alone, however many, left skin showing between them: 2,400 cards 4.4 mm wide
     with two in five of their texture's hairs kept covered some 70 % of the chin and
-    cheeks, and the rest read as skin blotches (a grey beard on pale skin most). 2,200
-    cards (8,800 vertices) over a 780-vertex undercoat stay under 10,000 vertices."""
-    return join([beard_undercoat(body), beard_cards(body, count, length)])
+    cheeks, and the rest read as skin blotches (a grey beard on pale skin most).
+
+    The cards grow in clumps, longest at the chin (``beard_reach``), over an undercoat in
+    their shade, and single stray hairs break up its soft edges (``beard_strays``): one
+    even pile of cards of one length, as light as the undercoat, read as felt. 1,800
+    cards (7,200 vertices), a 780-vertex undercoat and ~480 strays stay under 10,000."""
+    return join([beard_undercoat(body), beard_cards(body, count, length), beard_strays(body)])
 
 
 BEARD_UNDERCOAT_EASE_M = 0.0006  # off the skin (stubble lies at 0.5 mm, under it)
@@ -369,10 +373,59 @@ def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -
 
     return join([
         cards_on(body, keep & upper, flow, int(count * share), length, BEARD_CARD_M, lift,
-                 segments=1, density=density, strip=BEARD_STRIP),
+                 segments=1, density=density, strip=BEARD_STRIP, clump=BEARD_CLUMP),
         cards_on(body, keep & ~upper, flow, count - int(count * share), length, BEARD_CARD_M,
-                 lift, segments=1, seed=2, density=density, strip=BEARD_STRIP),
+                 lift, segments=1, seed=2, density=density, strip=BEARD_STRIP,
+                 reach=beard_reach(body), clump=BEARD_CLUMP, stand=0.8),
     ])  # fmt: skip
+
+
+BEARD_CLUMP = 7  # cards per clump (some 5 mm across where the beard is full)
+# A short beard's length by where it grows: this factor on the cards' length on the cheeks
+# (beyond ``BEARD_CHEEK_DEG`` round the face) and at the front of the chin; under the
+# chin the throat's hair is shorter again.
+BEARD_REACH = (0.7, 1.6)
+BEARD_CHEEK_DEG = (25, 50)
+
+
+def beard_reach(body: AuthoringBody):
+    """points (N, 3) -> (N,) a factor on a short beard's card length: longest at the
+    front of the chin below the lower lip (``BEARD_REACH[1]``), shortest on the cheeks
+    (``BEARD_REACH[0]``), shorter under the chin, blending smoothly between."""
+    centre, mouth, _, chin_z = mouth_frame(body)
+    cheek, chin = BEARD_REACH
+
+    def reach(points: np.ndarray) -> np.ndarray:
+        turn = around(points, centre)
+        front = np.clip((BEARD_CHEEK_DEG[1] - turn) / np.ptp(BEARD_CHEEK_DEG), 0, 1)
+        below = np.clip((mouth[2] - 0.012 - points[:, 2]) / 0.025, 0, 1)
+        throat = np.clip((chin_z - 0.005 - points[:, 2]) / 0.015, 0, 1)
+        return (cheek + (chin - cheek) * front * below) * (1 - 0.3 * throat)
+
+    return reach
+
+
+BEARD_STRAY_M = 0.0015  # a stray card's width: a hair or two (``BEARD_STRAY_STRIP``)
+BEARD_STRAY_STRIP = 0.015
+
+
+def beard_strays(body: AuthoringBody, count: int = 480) -> Piece:
+    """Single hairs over a short beard's soft edges (where ``facial_hair_density`` is
+    between 0.02 and 0.7: the cheek line, the neck line, round the sideburns): narrow
+    cards of a hair or two, standing a little off the skin, so the beard's edge breaks up
+    into hairs instead of ending in a thinning mat."""
+    centre, *_ = mouth_frame(body)
+    c = body.vertices[body.skin_faces].mean(axis=1)
+    d = facial_hair_density(body, "beard", c)
+    keep = facial_hair_mask(body, "beard") & (d > 0.02) & (d < 0.7)
+
+    def density(points: np.ndarray) -> np.ndarray:
+        g = facial_hair_density(body, "beard", points)
+        return np.clip(1 - np.abs(g - 0.3) / 0.35, 0, 1)
+
+    return cards_on(body, keep, _beard_flow(centre), count, (0.006, 0.014), BEARD_STRAY_M,
+                    (0.0015, 0.0055), segments=1, seed=6, density=density,
+                    strip=BEARD_STRAY_STRIP)  # fmt: skip
 
 
 BEARD_CARD_M = 0.0044  # a beard card's width

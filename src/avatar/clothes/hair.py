@@ -310,6 +310,8 @@ def cards_on(
     density=None,
     reach=None,
     strip: float = 0.12,
+    clump: int = 0,
+    stand: float = 0.0,
 ) -> Piece:
     """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
     ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
@@ -324,7 +326,13 @@ def cards_on(
 
     reach: roots (N, 3) -> (N,) a factor on the cards' length (None: 1), e.g. locks of
     longer and shorter hair along a moustache's lower edge. strip: the share of the
-    texture's width across a card (less: fewer, coarser hairs, as ``_card_piece``)."""
+    texture's width across a card (less: fewer, coarser hairs, as ``_card_piece``).
+
+    clump: cards per clump (0: none). Neighbouring roots are gathered into clumps of
+    about that many cards, each of its own length (70-130 %), whose tips are drawn
+    together (``CLUMP_PULL``): locks with skin-dark gaps between their tips, as a beard's
+    hair grows, instead of one even pile of cards. stand: how much a card's lift follows
+    its length (``reach``): 0 none, 1 a card twice as long stands twice as far out."""
     rng = np.random.default_rng([seed, count])
     roots = _scatter(body, keep, 3 * count, rng)
     grow = np.ones(len(roots)) if density is None else np.asarray(density(roots), float)
@@ -332,9 +340,13 @@ def cards_on(
     roots, grow = roots[pick], grow[pick]
     count = len(roots)
     size = rng.uniform(length[0], length[1], count) * (0.35 + 0.65 * grow)
-    if reach is not None:
-        size = size * np.asarray(reach(roots), float)
+    factor = np.ones(count) if reach is None else np.asarray(reach(roots), float)
+    size = size * factor
     top = rng.uniform(lift[0], lift[1], count) * (0.4 + 0.6 * grow)
+    top = top * (1 + stand * (factor - 1))
+    group = _clumps(roots, clump, rng) if clump > 0 else None
+    if group is not None:
+        size = size * rng.uniform(0.7, 1.3, group.max() + 1)[group]
     rows, point = [roots], roots
     for k in range(1, segments + 1):
         step = _tangent(body, point, flow(point))
@@ -342,8 +354,44 @@ def cards_on(
                             0.0008 + (top - 0.0008) * (k / segments))  # fmt: skip
         rows.append(point)
     path = np.stack(rows, 1)
+    if group is not None:
+        path = _gather(body, path, group, 0.0008 + (top[:, None] - 0.0008)
+                       * np.linspace(0, 1, segments + 1)[None, :])  # fmt: skip
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
-    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], strip=strip)
+    # A clump's cards show neighbouring strips of the texture (hairs of one shade, grey or
+    # not together), so each clump reads as a lock against the next.
+    u0 = None if group is None else (rng.uniform(0, 1, group.max() + 1)[group]
+                                     + rng.uniform(0, 2 * strip, count))  # fmt: skip
+    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], strip=strip,
+                       u0=u0)  # fmt: skip
+
+
+CLUMP_PULL = 0.8  # how far a clumped card's tip moves towards its clump's mean tip
+
+
+def _clumps(roots: np.ndarray, per: int, rng) -> np.ndarray:
+    """(N,) int clump of each root (N, 3): ``len(roots) / per`` random roots are the
+    clumps' seeds, and every root joins its nearest seed's clump."""
+    from scipy.spatial import cKDTree
+
+    seeds = rng.choice(len(roots), max(len(roots) // per, 1), replace=False)
+    return cKDTree(roots[seeds]).query(roots)[1]
+
+
+def _gather(body: AuthoringBody, path: np.ndarray, group: np.ndarray,
+            height: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) card paths whose points past the root are drawn towards their clump's
+    mean path (``group`` (N,)), more towards the tips (``CLUMP_PULL`` at the tip), then
+    set back ``height`` (N, K) m above the skin."""
+    n, k = path.shape[:2]
+    total = np.zeros((group.max() + 1, k, 3))
+    np.add.at(total, group, path)
+    mean = total / np.bincount(group, minlength=len(total))[:, None, None]
+    pull = CLUMP_PULL * np.linspace(0, 1, k)[None, :, None]
+    out = path + pull * (mean[group] - path)  # roots stay (pull 0), tips converge
+    flat = _above_skin(body, out[:, 1:].reshape(-1, 3), height[:, 1:].reshape(-1))
+    out[:, 1:] = flat.reshape(n, k - 1, 3)
+    return out
 
 
 def _scatter(body: AuthoringBody, keep: np.ndarray, count: int, rng) -> np.ndarray:
@@ -512,18 +560,30 @@ def long_cards(
     # the other).
     turn = rng.uniform(-0.45, 0.45, count)[:, None, None] * below
     facing = np.cos(turn) * normal + np.sin(turn) * sideways
-    return _card_piece(body, path, facing, width, rng)
+    # Textured from part way down the strands (lighter than their roots), the inner
+    # layers most: starting at the strands' dark roots, and under the layers over them,
+    # the hair hanging below the ears rendered darker than short hair of its colour.
+    inner = 1 - np.clip((height[:, -1, 0] - layers[0]) / (layers[1] - layers[0]), 0, 1)
+    root_v = LONG_ROOT_V - LONG_INNER_V * inner
+    return _card_piece(body, path, facing, width, rng, root_v=root_v)
+
+
+LONG_ROOT_V = 0.4  # long cards' texture starts here at the roots (0.5: the darkest roots)
+LONG_INNER_V = 0.1  # ... and this much further towards the tips on the innermost layer
 
 
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
                 surface: np.ndarray | None = None, taper=0.7,
-                tip_v: float = 0.0, strip: float = 0.12) -> Piece:  # fmt: skip
+                tip_v: float = 0.0, strip: float = 0.12, u0=None,
+                root_v=0.5) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
     (or to ``surface``, (S, 4) base-mesh faces of it), ``width`` m wide (a float or one per
     card, (N,)), narrowing to ``taper`` (a float or (N,)) of their width at the tips,
     their texture running from the roots (v = 0.5) to ``tip_v`` (0: the texture's
     thinned-out strand tips; more: cut ends, as a blunt haircut has) and across a random
-    ``strip`` of its width (how many of its hairs a card shows)."""
+    ``strip`` of its width (how many of its hairs a card shows); ``u0`` (N,) the strips'
+    left edges (None: random); ``root_v`` (a float or (N,)) where the texture starts at
+    the root (0.5: the strands' dark roots; less: lighter, further along the strands)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
@@ -535,8 +595,9 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     j = np.arange(k - 1)
     quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
     faces = (quad[None] + (2 * k * np.arange(count))[:, None, None]).reshape(-1, 4)
-    u0 = rng.uniform(0, 1, count)[:, None]
-    v = 0.5 - (0.5 - tip_v) * np.linspace(0, 1, k)[None, :]
+    u0 = (rng.uniform(0, 1, count) if u0 is None else np.asarray(u0, np.float64))[:, None]
+    root_v = np.broadcast_to(np.asarray(root_v, np.float64), (count,))[:, None]
+    v = root_v - (root_v - tip_v) * np.linspace(0, 1, k)[None, :]
     left = np.stack(np.broadcast_arrays(u0, v), -1)
     uv = np.concatenate([left, left + [strip, 0.0]], 1).reshape(-1, 2).astype(np.float32)
     mesh = orient_outward(body, verts.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))

@@ -75,6 +75,7 @@ def grey_share(age: float) -> float:
 # hair layout (v in [0.5, 1]): its hairs cover none of the skin at v = UNDERCOAT_V[0] and
 # all of it from UNDERCOAT_V[1] up.
 UNDERCOAT_V = (0.52, 0.9)
+UNDERCOAT_SHADE = 0.72  # sRGB factor on the undercoat (about half as light, linear)
 UNDERCOAT_CLIMB = 0.09  # where it is full, v climbs this much up the face (from 0.9)
 
 
@@ -110,6 +111,11 @@ def beard_material(spec, size: int = 1024) -> Material:
     cover = np.maximum(kept.astype(np.float32), fine)[None, :] * tip
     colour[cards, :, 3] = np.round(colour[cards, :, 3] * cover).astype(np.uint8)
     colour[: size - half, :, 3] = undercoat_alpha(size - half, size, hair, rng)
+    # The undercoat is the hair deep in the beard, in the shade of the clumps over it:
+    # as light as the cards, the gaps between clumps did not show and the beard read as
+    # one even mat.
+    under = colour[: size - half, :, :3].astype(np.float32)
+    colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
     return replace(m, base_color_texture=colour)
 
 
@@ -238,7 +244,11 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
     if share > 0:
         rng = np.random.default_rng([size[0], size[1], 31])
         if kind == "cards":  # whole strands grey: salt and pepper
-            grey = np.broadcast_to(rng.uniform(size=size[1])[None, :] < share, size)
+            grey = np.array(np.broadcast_to(rng.uniform(size=size[1])[None, :] < share, size))
+            # The dense half (caps, a beard's undercoat) hair by hair: whole columns grey
+            # ran as streaks up a cap and down a beard.
+            hairs = textures.dense_hairs(size[0] // 2, size[1], rng)
+            grey[: size[0] // 2] = rng.uniform(size=hairs.max() + 1)[hairs] < share
         else:
             grey = rng.uniform(size=size) < share
         white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey

@@ -151,8 +151,16 @@ def strand_alpha(size: int, seed: int = 0) -> np.ndarray:
     fade = np.clip((length[None, :] - t[:, None]) / 0.08, 0, 1)
     strands = 0.55 + 0.45 * np.sin(2 * np.pi * cols * 97 / size + rng.uniform(0, 6, size)) ** 2
     card = fade * strands[None, :] * (rng.uniform(size=size) < 0.9)[None, :]
-    dense = np.ones((size - half, size), np.float32)
+    # The dense half (scalp caps) with a few of its short hairs missing (``SCALP_SHOWS``):
+    # seen through the gaps between a buzz cut's cards, an opaque cap read as a textured
+    # helmet; now the scalp shows faintly through, as under real close-cropped hair.
+    gaps = np.random.default_rng([seed, size, 5])
+    hairs = dense_hairs(size - half, size, gaps)
+    dense = (gaps.uniform(size=hairs.max() + 1) >= SCALP_SHOWS)[hairs].astype(np.float32)
     return np.round(np.concatenate([dense, card]) * 255).astype(np.uint8)
+
+
+SCALP_SHOWS = 0.18  # share of the dense half's short hairs left out (scalp between them)
 
 
 def strand_shade(size: int, seed: int = 0) -> np.ndarray:
@@ -165,7 +173,26 @@ def strand_shade(size: int, seed: int = 0) -> np.ndarray:
     half = size // 2
     t = (np.arange(size - half) + 0.5) / (size - half)  # 0 at the roots, 1 at the tips
     along = np.concatenate([np.full(half, 0.72), 0.6 + 0.65 * t**0.8])
-    return (along[:, None] * strand[None, :]).astype(np.float32)
+    shade = along[:, None] * strand[None, :]
+    # The dense half in short hairs (``dense_hairs``), each of its own shade: one shade a
+    # column from v = 0.5 to 1 drew streaks the height of a scalp cap (a buzz cut's most).
+    hairs = dense_hairs(half, size, rng)
+    shade[:half] = 0.72 * locks[None, :] * rng.uniform(0.75, 1.25, hairs.max() + 1)[hairs]
+    return shade.astype(np.float32)
+
+
+DENSE_HAIR_ROWS = 1 / 96  # of the texture's height: a hair's length in the dense half
+
+
+def dense_hairs(rows: int, size: int, rng) -> np.ndarray:
+    """Indices ((rows, size) int) numbering short hairs down a (rows, size) block of a
+    ``size`` texture's dense half: each column cut into lengths of ``DENSE_HAIR_ROWS``,
+    staggered column to column (hair ends do not line up into rows). Index an array of
+    one value per hair with it (``values[index]``, values of ``index.max() + 1``)."""
+    seg = max(int(round(size * DENSE_HAIR_ROWS)), 1)
+    offset = rng.integers(0, seg, size)
+    along = (np.arange(rows)[:, None] + offset[None, :]) // seg
+    return along * size + np.arange(size)[None, :]
 
 
 def brow_shade(rgb: np.ndarray) -> float:
