@@ -112,6 +112,11 @@ def _new_material(record, fallback_name: str) -> bpy.types.Material:
 # v = 0.5 to tip v = 0, scalp caps bottom to top, lashes lid to tip; ``looks.textures``).
 HAIR_ANISOTROPY = 0.8  # how stretched the highlight is across the strands (0..1)
 HAIR_SHEEN = 0.25  # the soft fibre rim seen at grazing angles
+# Share of light a hair card passes through to its far side (a Translucent BSDF added,
+# in Cycles): hair is a bundle of thin fibres, not a sheet, and lit from behind or through
+# the layers above it glows in its own colour. Opaque cards shadowed each other: long hair
+# hanging below the ears rendered darker than short hair of the same colour.
+HAIR_TRANSLUCENCY = 0.6
 UV_MAP = "UVMap"  # the layer ``blender.mesh`` makes
 
 
@@ -163,6 +168,48 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
     fade.inputs["From Min"].default_value, fade.inputs["From Max"].default_value = 0.0, 0.5
     fade.inputs["To Min"].default_value, fade.inputs["To Max"].default_value = level, 0.4 * level
     tree.links.new(fade.outputs["Result"], specular)
+    translucency(tree, bsdf)
+
+
+def translucency(tree, bsdf: bpy.types.Node, amount: float = HAIR_TRANSLUCENCY) -> None:
+    """Cycles shades a hair material as its Principled BSDF plus a Translucent BSDF in
+    ``amount`` times the hair's colour (light through the card from its far side; added,
+    not mixed in, so a card lit from the front keeps all its reflection), cut out by the
+    same alpha, on a Material Output of its own (target Cycles). The Principled BSDF stays
+    wired to the material's first output (target All): EEVEE draws it, and the FBX and USD
+    exporters look for a Principled BSDF linked straight to an output."""
+    nodes, links = tree.nodes, tree.links
+    tint = nodes.new("ShaderNodeVectorMath")
+    tint.operation, tint.location = "SCALE", (0, -450)
+    tint.inputs["Scale"].default_value = amount
+    colour = bsdf.inputs["Base Color"]
+    if colour.links:
+        links.new(colour.links[0].from_socket, tint.inputs[0])
+    else:
+        tint.inputs[0].default_value = tuple(colour.default_value)[:3]
+    through = nodes.new("ShaderNodeBsdfTranslucent")
+    through.location = (200, -450)
+    links.new(tint.outputs["Vector"], through.inputs["Color"])
+    fibre = nodes.new("ShaderNodeAddShader")
+    fibre.location = (450, -250)
+    links.new(bsdf.outputs["BSDF"], fibre.inputs[0])
+    links.new(through.outputs["BSDF"], fibre.inputs[1])
+    # Cut out where the Principled BSDF is (its alpha), so the gaps between strands stay
+    # see-through: the Translucent BSDF has no alpha of its own.
+    cut_out = nodes.new("ShaderNodeMixShader")
+    cut_out.location = (650, -250)
+    clear = nodes.new("ShaderNodeBsdfTransparent")
+    clear.location = (450, -450)
+    alpha = bsdf.inputs["Alpha"]
+    if alpha.links:
+        links.new(alpha.links[0].from_socket, cut_out.inputs["Fac"])
+    else:
+        cut_out.inputs["Fac"].default_value = alpha.default_value
+    links.new(clear.outputs["BSDF"], cut_out.inputs[1])
+    links.new(fibre.outputs["Shader"], cut_out.inputs[2])
+    output = nodes.new("ShaderNodeOutputMaterial")
+    output.target, output.location = "CYCLES", (850, -250)
+    links.new(cut_out.outputs["Shader"], output.inputs["Surface"])
 
 
 def allow_transparent_layers(scene: bpy.types.Scene, layers: int = 64) -> None:
