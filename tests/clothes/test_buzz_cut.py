@@ -61,3 +61,31 @@ def test_buzz_cap_texture_is_short_hairs_not_streaks():
     light = tex[:128, :, :3].astype(np.float64).mean(-1)  # the dense half's rows
     along = (light.std(axis=0) / light.mean(axis=0)).mean()  # within each column
     assert along > 0.05
+
+
+def test_scalp_shows_faintly_through_the_cap():
+    """A few of the cap's short hairs are left out (the scalp shows faintly through a buzz
+    cut, which read as a textured helmet), one hair at a time: no column left bare."""
+    from avatar.clothes.library import load_garment
+
+    alpha = load_garment("hair-buzz", texture_size=256).material.base_color_texture[:128, :, 3]
+    bare = alpha < 128
+    assert 0.1 < bare.mean() < 0.3
+    assert bare.all(axis=0).mean() < 0.01
+
+
+def test_cap_is_tucked_down_to_the_skin_at_the_hairline():
+    """The base cap's rim lies on the skin (within 0.5 mm) and rises to its ease inside
+    the hairline: standing 1.5 mm off the forehead, its edge cast a dark line along the
+    buzz cut's hairline."""
+    from avatar.clothes import hair, library
+    from avatar.geometry.shell import boundary_edges
+
+    body = library.authoring_body()
+    cap = hair.base_cap(body, CAP).mesh
+    rim = np.unique(boundary_edges(cap.faces)[0])
+    height = _height_off_skin(body, cap.vertices.astype(np.float64))
+    centre, _ = hair.head_frame(body)
+    front = hair.around(cap.vertices[rim].astype(np.float64), centre) < 60
+    assert front.sum() > 10 and np.median(height[rim][front]) < 0.0005
+    assert np.median(np.delete(height, rim)) == pytest.approx(CAP, abs=2e-4)

@@ -120,11 +120,24 @@ def hairline_mask(body: AuthoringBody, lift: float = 0.0) -> np.ndarray:
     return near & outside & (c[:, 2] > line) & ~ear
 
 
+CAP_RIM_M = 0.0003  # the cap's rim lies this far off the skin ...
+CAP_TUCK_M = 0.008  # ... rising to its ease over this much height above the hairline
+
+
 def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:
-    """The scalp inside the hairline as a dense hair surface (what shows between cards)."""
+    """The scalp inside the hairline as a dense hair surface (what shows between cards),
+    ``ease`` m off the skin but tucked down to it at the hairline (``CAP_RIM_M``): a rim
+    standing 1.5-2 mm off the forehead cast a dark line along a buzz cut's hairline, the
+    edge of a cap."""
     faces = body.skin_faces
-    mesh = cut(body, faces, hairline_mask(body), ease, relax=8)
-    centre, _ = head_frame(body)
+    centre, eye_z = head_frame(body)
+
+    def lift(points: np.ndarray, arm, leg) -> np.ndarray:
+        line = eye_z + np.interp(around(points, centre), HAIRLINE_DEG, HAIRLINE_M)
+        rise = np.clip((points[:, 2] - line) / CAP_TUCK_M, 0, 1)
+        return CAP_RIM_M + (ease - CAP_RIM_M) * rise * rise * (3 - 2 * rise)
+
+    mesh = cut(body, faces, hairline_mask(body), lift, relax=8)
     return bound(body, cap_uvs(mesh, centre), faces)
 
 
