@@ -112,3 +112,17 @@ def test_long_hair_below_the_ears_is_not_dark(empty_scene, tmp_path):
     assert below.sum() > 500
     ratio = long_[below].mean() / short[short_hair].mean()
     assert ratio > 0.49, ratio
+
+
+def test_beard_passes_less_light_than_scalp_hair(empty_scene):
+    """A beard's cards lie on the skin in one layer: little light through them (a grey
+    beard's clumps lit from behind glowed white at scalp hair's translucency)."""
+    from avatar.blender import materials
+    from avatar.clothes.library import load_garment
+
+    def amount(name):
+        mat = materials.material(load_garment(name, texture_size=64).material)
+        through = next(n for n in mat.node_tree.nodes if n.type == "BSDF_TRANSLUCENT")
+        return through.inputs["Color"].links[0].from_node.inputs["Scale"].default_value
+
+    assert amount("beard-short") < 0.5 * amount("hair-short")

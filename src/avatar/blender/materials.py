@@ -116,7 +116,7 @@ HAIR_SHEEN = 0.25  # the soft fibre rim seen at grazing angles
 # in Cycles): hair is a bundle of thin fibres, not a sheet, and lit from behind or through
 # the layers above it glows in its own colour. Opaque cards shadowed each other: long hair
 # hanging below the ears rendered darker than short hair of the same colour.
-HAIR_TRANSLUCENCY = 0.6
+HAIR_TRANSLUCENCY = 0.6  # a ``translucency`` hint in a record's extras overrides it
 UV_MAP = "UVMap"  # the layer ``blender.mesh`` makes
 
 
@@ -168,7 +168,9 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
     fade.inputs["From Min"].default_value, fade.inputs["From Max"].default_value = 0.0, 0.5
     fade.inputs["To Min"].default_value, fade.inputs["To Max"].default_value = level, 0.4 * level
     tree.links.new(fade.outputs["Result"], specular)
-    translucency(tree, bsdf)
+    amount = float(record.extras.get("translucency", HAIR_TRANSLUCENCY))
+    if amount > 0:
+        translucency(tree, bsdf, amount)
 
 
 def translucency(tree, bsdf: bpy.types.Node, amount: float = HAIR_TRANSLUCENCY) -> None:

@@ -116,7 +116,14 @@ def beard_material(spec, size: int = 1024) -> Material:
     # one even mat.
     under = colour[: size - half, :, :3].astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
-    return replace(m, base_color_texture=colour)
+    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY}
+    return replace(m, base_color_texture=colour, extras=extras)
+
+
+# Light a beard's cards pass through (the renderer's hint, ``blender.materials``): they lie
+# on the skin, one layer over the undercoat, so little; at scalp hair's 0.6 a grey beard's
+# clumps lit from behind by the key light glowed white, flakes of cotton wool.
+BEARD_TRANSLUCENCY = 0.15
 
 
 def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
