@@ -4,13 +4,15 @@ and laces, all generated on the authoring body and bound to it, so they fit ever
 Parts, per foot (``x > 0`` is the body's left):
 
 - upper: the ``helper-tights`` faces of the foot and ankle, eased off the skin, its
-  opening smoothed into a curve, the toe box drawn out past the toes and sloping down to
-  its tip, the bottom edge drawn down to just above the ground;
+  opening smoothed into a curve, split finer and moved onto a last (``_Last``): the
+  foot's outline in plan with upright walls (a vertical heel counter, straight sides
+  down to the sole), rolling over onto a vamp that runs straight down to an almond toe
+  box past the toes; the bottom edge drawn down to just above the ground;
 - sole: a thin edge (``_sole_edge``) round the upper's bottom edge, out by a welt, down to
   a tread a little below the foot, taller at the heel (a heel block), lifted under the
   arch and curling up at the toe (toe spring), closed underneath;
-- toe cap: the front of the upper again, sewn flat on it (under a millimetre out), its
-  back edge (the seam over the vamp) double-stitched;
+- toe cap: the front of the upper again, on the same last 1.2 mm out, its back edge
+  (the seam over the vamp) smoothed into a curve and double-stitched;
 - lacing (``lacing``): a tongue under the laces, two quarters' facings either side of it
   with eyelets, and one lace criss-crossing from eyelet to eyelet (each crossing over the
   one before), tied in a bow at the top;
@@ -54,7 +56,6 @@ CAP_EASE = EASE + 0.0012  # a toe cap sewn flat on the vamp, not a shell over it
 # cutting the faces lower let the toes' bumps through the leather.
 OPEN_BOTTOM = 0.012
 EDGE = 0.002
-SOCK_ROOM = 0.001  # m a smoothed toe box may sink inside the cut (a sock is 2 mm inside)
 DRAWN_CLEAR = 0.003  # m over the ease the drawn edge keeps: room for a sock where the foot flares
 LACES = 5  # eyelet pairs up each side of the lacing
 
@@ -136,16 +137,39 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     return bound(body, _planar_uvs(mesh, "upper"), faces)
 
 
-def _drawn_down(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float = EASE) -> Mesh:
+def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float,
+             smooth_rim: int = 0) -> Mesh:  # fmt: skip
+    """The toe box, and all the shoe: a cut of the foot's faces, split finer and moved onto
+    the last (``_Last``), still ``ease`` off the skin; ``smooth_rim``: passes smoothing
+    the cut (its boundary along itself, the rest after it) before it goes on the last
+    again, so a seam runs in a curve, not in whole faces' steps."""
+    mesh = _subdivided(mesh)
+    last = _Last(body, foot, ease)
+    points = last.shape(mesh.vertices.astype(np.float64))
+    if smooth_rim:
+        points = last.shape(_smoothed(mesh.faces, points, smooth_rim))
+    # Out to ``ease`` along the nearest skin vertex's normal where the last cuts into the
+    # foot (a few vertices at the ankle): the worst of eight neighbours (``_at_least``)
+    # pushed a third of the shell out up to 16 mm, lumps all over the leather.
+    _, i = body.skin_tree.query(points)
+    normal = body.skin_normals[i].astype(np.float64)
+    gap = np.einsum("nd,nd->n", points - body.vertices[i], normal)
+    points += np.clip(ease - gap, 0, None)[:, None] * normal
+    return Mesh(points.astype(np.float32), mesh.faces)
+
+
+def _drawn_down(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float | None = None,
+                reach: float = OPEN_BOTTOM + 0.01) -> Mesh:  # fmt: skip
     """The upper with its bottom edge drawn straight down to EDGE m above the ground, the
     tip curling up with the sole's toe spring (the sole can only curl as far as the edge
     it covers), still ``ease`` + DRAWN_CLEAR off the skin."""
     v = mesh.vertices.astype(np.float64)
     loop = _lowest_loop(mesh)
-    loop = loop[v[loop, 2] < foot.ground + OPEN_BOTTOM + 0.01]  # a toe cap's back edge stays
+    loop = loop[v[loop, 2] < foot.ground + reach]  # a toe cap's back edge stays
     spring = SPRING * np.clip((foot.along(v[loop]) - 0.84) / 0.2, 0, 1) ** 2
     v[loop, 2] = np.minimum(v[loop, 2], foot.ground + EDGE + spring)
-    v[loop] = _at_least(body, v[loop], ease + DRAWN_CLEAR)
+    if ease is not None:  # on a last the wall already stands clear of the foot
+        v[loop] = _at_least(body, v[loop], ease + DRAWN_CLEAR)
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
@@ -154,7 +178,10 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     centre = body.vertices[faces].mean(axis=1)
     keep = _shoe_faces(body, foot, faces) & (foot.along(centre) > 0.78)
     mesh = cut(body, faces, keep, CAP_EASE, relax=8)
-    mesh = _toe_box(body, foot, mesh, CAP_EASE)  # drawn down too, a sock showed at its corner
+    # Only its bottom edge drawn down to the sole: its seam, one boundary with it, comes
+    # down to the sole at the sides and was dragged into spikes.
+    mesh = _toe_box(body, foot, mesh, CAP_EASE, smooth_rim=6)
+    mesh = _drawn_down(body, foot, mesh, reach=OPEN_BOTTOM)
     return bound(body, _cap_uvs(mesh, foot), faces)
 
 
@@ -185,53 +212,6 @@ def cap_stitch_v(mm: float) -> float:
     """Atlas v of a stitch row ``mm`` millimetres in front of the toe cap's seam."""
     v0, v1 = ROWS["cap"]
     return v0 + (v1 - v0) * (0.05 + 0.9 * (1 - mm / 1000 / CAP_UV_REACH))
-
-
-def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float) -> Mesh:
-    """A shoe's shape, not the foot's: toes' bumps smoothed away (Laplacian passes over the
-    shell, then every vertex at least ``ease`` off the skin again), the front drawn out a
-    centimetre past the toes into a rounded box."""
-    v = mesh.vertices.astype(np.float64)
-    v0 = v.copy()
-    a = mesh.faces.reshape(-1)
-    b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
-    degree = np.bincount(a, minlength=len(v)) + np.bincount(b, minlength=len(v))
-    from avatar.geometry.shell import boundary_edges
-
-    edges, _ = boundary_edges(mesh.faces)
-    rim = np.zeros(len(v), bool)
-    rim[edges.ravel()] = True  # the opening and the bottom edge keep their curves
-    t = foot.along(v)
-    weight = np.clip((t - 0.55) / 0.25, 0, 1)[:, None]  # smooth the forefoot most
-    for _ in range(12):
-        total = np.zeros_like(v)
-        np.add.at(total, a, v[b])
-        np.add.at(total, b, v[a])
-        average = total / np.maximum(degree, 1)[:, None]
-        v = np.where(rim[:, None], v, v + 0.6 * (0.3 + 0.7 * weight) * (average - v))
-    front = np.clip((t - 0.6) / 0.4, 0, 1) ** 2
-    v[:, 1] -= 0.016 * front  # the toe box reaches past the toes
-    # ... and slopes down to its tip (a last's toe, not a clog's blunt dome): in front of
-    # the toes the height over the sole taken down by up to 40% (over the toes it pushed
-    # the bumps of the toes back into the leather, and a sock through it).
-    tip = np.clip((t - 0.93) / 0.15, 0, 1) ** 2
-    v[:, 2] -= 0.4 * tip * np.clip(v[:, 2] - foot.ground - 0.008, 0, None)
-    # Smoothing pulls the convex parts in (the little toe's joint), where the shell stands
-    # well off the skin: a sock cut from the shell showed through. Each vertex stays within
-    # SOCK_ROOM inside the cut's own surface, and ``ease`` off the skin.
-    normal0 = body.outward(v0)
-    inward = np.einsum("nd,nd->n", v - v0, normal0)
-    v += np.clip(-SOCK_ROOM - inward, 0, None)[:, None] * normal0
-    v = _at_least(body, v, ease)
-    # Fill the hollows between toes: smoothing that only ever moves a vertex outwards.
-    normal = body.outward(v)
-    for _ in range(10):
-        total = np.zeros_like(v)
-        np.add.at(total, a, v[b])
-        np.add.at(total, b, v[a])
-        rise = np.einsum("nd,nd->n", total / np.maximum(degree, 1)[:, None] - v, normal)
-        v = np.where(rim[:, None], v, v + (np.clip(rise, 0, None) * weight[:, 0])[:, None] * normal)
-    return Mesh(v.astype(np.float32), mesh.faces)
 
 
 def _at_least(body: AuthoringBody, points: np.ndarray, gap: float) -> np.ndarray:
@@ -594,6 +574,199 @@ def shoes(body: AuthoringBody, top: float = 0.96, style: Style = SHOE) -> Piece:
 def sneakers(body: AuthoringBody) -> Piece:
     """Low sneakers: the shoe on a deep midsole with a toe bumper and a heel tab."""
     return shoes(body, style=SNEAKER)
+
+
+# ---------------------------------------------------------------------------- the last
+# A shoe is made on a last, not on the foot: its upper follows the foot's outline in plan
+# (the footprint's convex hull, eased, the toe box drawn out past the toes) with upright
+# walls WALL m high round the sole, rolling over (a quarter round of radius up to
+# ROLL x the height left) onto a top that runs straight down the vamp from the throat to
+# the toe. Shaped from the foot's helper faces the upper was a smoothed foot: an inflated
+# shell, the vamp domed, the toe a ball, the sides bulging over a pinched bottom edge.
+WALL = 0.011
+ROLL = 0.75
+TOE_BOX = 0.016  # m the toe box reaches past the toes
+TAPER = 0.3  # how much narrower the toe box's tip is than the toes' spread
+VAMP = (0.66, 0.98)  # along the foot: the vamp's straight run, from the throat to the toe
+SHAPED_TO = (0.07, 0.1)  # m above the ground: shaped fully below, not at all above (a boot)
+
+
+class _Last:
+    """The last a shoe is made on: its outline in plan, wall and top heights along the foot."""
+
+    def __init__(self, body: AuthoringBody, foot: Foot, ease: float):
+        skin = body.vertices[: len(body.part)]
+        near = (np.sign(skin[:, 0]) == (1 if foot.side == 0 else -1)) & (
+            skin[:, 2] < foot.ground + 0.13) & (np.abs(skin[:, 0] - foot.centre_x) < 0.08)
+        low = near & (skin[:, 2] < foot.ground + 0.07)  # all the shoe covers: no dents
+        from scipy.spatial import ConvexHull
+
+        plan = skin[low, :2].astype(np.float64)
+        hull = plan[ConvexHull(plan).vertices]
+        self.outline = _offset_outline(hull, ease, foot)
+        self.foot, self.ease = foot, ease
+        # Stations along the foot: half-width in plan and the top (the skin's highest point
+        # there, eased; straight down the vamp).
+        self.t = np.linspace(-0.15, 1.2, 82)
+        y = foot.heel_y - self.t * (foot.heel_y - foot.toe_y)
+        points = skin[near & (body.part == "foot")]  # the leg's front is the throat's
+        along = foot.along(points)
+        top = np.full(len(self.t), np.nan)
+        for k, tk in enumerate(self.t):
+            band = np.abs(along - tk) < 0.02
+            if band.any():
+                top[k] = points[band, 2].max() + ease
+        have = np.isfinite(top)
+        top = np.interp(self.t, self.t[have], top[have])
+        top[self.t > 1.0] = top[self.t <= 1.0][-1]
+        a, b = VAMP
+        ha = float(np.interp(a, self.t, top))
+        toe = float(np.interp(b, self.t, top))  # over the toes' tips
+        line = ha + (toe - ha) * (self.t - a) / (b - a)
+        line -= 2 * (ha - toe) * np.clip(self.t - b, 0, None) / (b - a)  # the toe's slope
+        top = np.where(self.t >= a, np.maximum(line, np.where(self.t <= 1.0, top, -1)), top)
+        # Behind the throat the counter and quarters stand up to the topline, no top.
+        self.top = np.maximum(top, 0.3 * np.clip((0.4 - self.t) / 0.1, 0, 1))
+        self.half = np.array([_half_width(self.outline, yk) for yk in y])
+
+    def bottom(self, t: np.ndarray) -> np.ndarray:
+        """(N,) z of the last's bottom edge: EDGE above the ground, curling up at the toe."""
+        return self.foot.ground + EDGE + SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
+
+    def inside(self, q: np.ndarray) -> np.ndarray:
+        """(N,) bool: points (N, 3) inside the last."""
+        t = self.foot.along(q)
+        depth = _depth_in(self.outline, q[:, :2])  # m inside the outline in plan (< 0 out)
+        bottom = self.bottom(t)
+        wall = bottom + WALL * (1 - 0.5 * np.clip((t - 0.85) / 0.2, 0, 1))  # lower at the toe
+        height = np.interp(t, self.t, self.top) - wall
+        radius = np.clip(np.minimum(ROLL * height, 0.9 * np.interp(t, self.t, self.half)),
+                         0.004, None)  # fmt: skip
+        floor = bottom - 0.01  # open below its bottom edge: the sole covers it
+        u = np.clip(depth / radius, 0, 1)
+        ceiling = wall + height * np.sqrt(np.clip(1 - (1 - u) ** 2, 0, 1))
+        ceiling = np.where(depth >= radius, wall + height, ceiling)
+        return (depth > 0) & (q[:, 2] > floor) & (q[:, 2] < np.maximum(ceiling, wall))
+
+    def shape(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) points moved along rays from inside the foot to the last's surface."""
+        foot = self.foot
+        t = np.clip(foot.along(points), 0.2, 0.85)
+        y = foot.heel_y - t * (foot.heel_y - foot.toe_y)
+        x = np.array([_middle(self.outline, yk) for yk in y])
+        origin = np.column_stack([x, y, np.full(len(y), foot.ground + 0.02)])
+        ray = points - origin
+        ray /= np.maximum(np.linalg.norm(ray, axis=1, keepdims=True), 1e-9)
+        steps = np.linspace(0.0, 0.2, 101)
+        inside = np.stack([self.inside(origin + s * ray) for s in steps], 1)
+        first_out = np.argmax(~inside, axis=1)  # the first sample outside
+        lo, hi = steps[np.maximum(first_out - 1, 0)], steps[first_out]
+        for _ in range(14):
+            mid = (lo + hi) / 2
+            ins = self.inside(origin + mid[:, None] * ray)
+            lo, hi = np.where(ins, mid, lo), np.where(ins, hi, mid)
+        shaped = origin + ((lo + hi) / 2)[:, None] * ray
+        z = points[:, 2] - foot.ground
+        weight = np.clip((SHAPED_TO[1] - z) / (SHAPED_TO[1] - SHAPED_TO[0]), 0, 1)[:, None]
+        return points + weight * (shaped - points)
+
+
+def _offset_outline(hull: np.ndarray, ease: float, foot: Foot, n: int = 96) -> np.ndarray:
+    """(n, 2) the hull (K, 2) resampled evenly, out by ``ease``, its front drawn out."""
+    closed = np.concatenate([hull, hull[:1]])
+    length = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    s = np.linspace(0, length[-1], n, endpoint=False)
+    ring = np.column_stack([np.interp(s, length, closed[:, 0]), np.interp(s, length, closed[:, 1])])
+    centre = ring.mean(axis=0)
+    for _ in range(3):  # round the hull's corners
+        ring = 0.5 * ring + 0.25 * (np.roll(ring, 1, 0) + np.roll(ring, -1, 0))
+    tangent = np.roll(ring, -1, 0) - np.roll(ring, 1, 0)
+    normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    normal *= np.sign(np.einsum("nd,nd->n", normal, ring - centre))[:, None]
+    ring = ring + ease * normal
+    t = foot.along(np.column_stack([ring, np.zeros(n)]))
+    ring[:, 1] -= TOE_BOX * np.clip((t - 0.6) / 0.4, 0, 1) ** 2
+    # An almond toe, not the toes' square front: the box narrowed towards its tip.
+    front = t > 0.8
+    middle = float(ring[front, 0].mean())
+    ring[:, 0] = middle + (ring[:, 0] - middle) * (1 - TAPER * np.clip((t - 0.85) / 0.25, 0, 1))
+    return ring
+
+
+def _depth_in(outline: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """(N,) signed distance (m, > 0 inside) of plan points (N, 2) from a closed outline."""
+    a, b = outline, np.roll(outline, -1, 0)
+    ab = b - a
+    rel = q[:, None] - a[None]
+    s = np.clip(np.einsum("nkd,kd->nk", rel, ab) / np.einsum("kd,kd->k", ab, ab), 0, 1)
+    d = np.linalg.norm(rel - s[..., None] * ab[None], axis=2).min(axis=1)
+    crosses = (a[None, :, 1] > q[:, None, 1]) != (b[None, :, 1] > q[:, None, 1])
+    x_at = a[None, :, 0] + (q[:, None, 1] - a[None, :, 1]) * ab[None, :, 0] / np.where(
+        ab[None, :, 1] == 0, 1e-12, ab[None, :, 1])
+    inside = (crosses & (q[:, None, 0] < x_at)).sum(axis=1) % 2 == 1
+    return np.where(inside, d, -d)
+
+
+def _crossing(outline: np.ndarray, y: float) -> np.ndarray:
+    """x where the outline crosses the line at ``y``."""
+    a, b = outline, np.roll(outline, -1, 0)
+    hit = (a[:, 1] > y) != (b[:, 1] > y)
+    return a[hit, 0] + (y - a[hit, 1]) * (b[hit, 0] - a[hit, 0]) / (b[hit, 1] - a[hit, 1])
+
+
+def _half_width(outline: np.ndarray, y: float) -> float:
+    x = _crossing(outline, y)
+    return float(np.ptp(x) / 2) if len(x) >= 2 else 0.0
+
+
+def _middle(outline: np.ndarray, y: float) -> float:
+    x = _crossing(outline, y)
+    return float(x.mean()) if len(x) else float(outline[:, 0].mean())
+
+
+def _smoothed(faces: np.ndarray, points: np.ndarray, passes: int) -> np.ndarray:
+    """(N, 3) points Laplacian-smoothed over the mesh: boundary vertices only along the
+    boundary (its curve smoothed, not pulled in), the others over their neighbours."""
+    from avatar.geometry.shell import boundary_edges
+
+    a = faces.reshape(-1).astype(np.int64)
+    b = np.roll(faces, -1, axis=1).reshape(-1).astype(np.int64)
+    rim, _ = boundary_edges(faces)
+    on_rim = np.zeros(len(points), bool)
+    on_rim[rim.ravel()] = True
+    n = len(points)
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    along = np.isin(key, np.minimum(rim[:, 0], rim[:, 1]).astype(np.int64) * n
+                    + np.maximum(rim[:, 0], rim[:, 1]))  # fmt: skip
+    p = points.copy()
+    for _ in range(passes):
+        total, count = np.zeros_like(p), np.zeros(n)
+        for i, j in ((a, b), (b, a)):  # i takes j's position where it may
+            use = ~on_rim[i] | along
+            np.add.at(total, i[use], p[j[use]])
+            np.add.at(count, i[use], 1)
+        moved = total / np.maximum(count, 1)[:, None]
+        p = np.where((count > 0)[:, None], 0.5 * p + 0.5 * moved, p)
+    return p
+
+
+def _subdivided(mesh: Mesh) -> Mesh:
+    """Each quad split in four (edge midpoints, face centre): room for the last's edges."""
+    v = mesh.vertices.astype(np.float64)
+    f = mesh.faces
+    edges = np.sort(np.stack([f, np.roll(f, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    inverse = inverse.reshape(f.shape)
+    mids = v[unique].mean(axis=1)
+    centres = v[f].mean(axis=1)
+    e0, c0 = len(v), len(v) + len(unique)
+    faces = []
+    for k in range(4):  # corner k, the edge after it, the centre, the edge before it
+        faces.append(np.stack([f[:, k], e0 + inverse[:, k], c0 + np.arange(len(f)),
+                               e0 + inverse[:, (k - 1) % 4]], 1))  # fmt: skip
+    points = np.concatenate([v, mids, centres]).astype(np.float32)
+    return Mesh(points, np.concatenate(faces).astype(np.int32))
 
 
 # ---------------------------------------------------------------------------- look
