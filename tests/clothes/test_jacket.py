@@ -120,3 +120,23 @@ def test_jacket_fabric_and_colour_variants_keep_its_construction(piece, maps):
     leather = rough[rough > np.percentile(rough, 5)]
     assert 0.45 < np.median(leather) < 0.8 and np.percentile(leather, 95) - np.percentile(
         leather, 5) < 0.3  # fmt: skip
+
+
+def test_jacket_construction_reads_on_black_leather(piece, maps):
+    """On black leather the stitching, the zip and the seams must still show: charcoal
+    thread came out 1.25x the leather's lightness (invisible in a render), dull teeth."""
+    colour = maps.base_color_texture.astype(float).mean(axis=2)
+    canvas = tailored.Canvas(colour.shape[0])
+    plain = np.median(colour)
+    stitches = _kinds(piece, "stitch")[0].points
+    d, _, w = canvas.distance(stitches, 3)
+    assert np.percentile(colour[w][d < 1], 90) > 1.8 * plain  # grey thread on black
+    teeth = np.concatenate([m.points for m in _kinds(piece, "rivet")])
+    d, _, w = canvas.distance(teeth[: len(teeth) // 2], 3)
+    assert colour[w][d < 1].mean() > 2.5 * plain  # bright nickel
+    tilt = _tilt(maps)
+    seams = _kinds(piece, "seam")[0].points
+    d, _, w = canvas.distance(seams, 6)
+    assert tilt[w][d < 4].mean() > 10 * np.median(tilt)  # groove and pressed allowance
+    folds = [m for m in _kinds(piece, "fold") if m.strength == jacket.ALLOWANCE]
+    assert folds and len(folds[0].points) == len(stitches)  # a ridge beside every seam

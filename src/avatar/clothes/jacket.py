@@ -34,8 +34,12 @@ PANELS = (*tailoring.TROUSER_PANELS,  # left front, left back, right front, righ
 BODY, SLEEVES = (0, 1, 2, 3), (4, 5)
 ZIP_TOOTH = 0.0035  # m between zip teeth
 COLLAR_REACH = 0.075  # m round the neck from the front opening (or centre back) to the shoulder
-THREAD = "charcoal"  # topstitching a shade off black leather
-ZIP_METAL = (0.5, 0.5, 0.52)  # nickel zip teeth and pulls (linear RGB)
+# Topstitching in a mid-grey thread and bright nickel teeth: in charcoal (0.06) on black
+# leather (0.03) the stitching was 1.25x the leather's lightness in the map and vanished in
+# a render, and the zip read as a dull line; grey thread is what leather jackets use.
+THREAD = (0.2, 0.2, 0.205)
+ZIP_METAL = (0.75, 0.75, 0.77)  # nickel zip teeth and pulls (linear RGB)
+ALLOWANCE = 0.6  # strength of the ridge a pressed seam allowance raises under the leather
 
 
 def _unwrapped(angle: np.ndarray, centre: np.ndarray) -> np.ndarray:
@@ -214,7 +218,9 @@ def topstitched_seams(panels: JacketPanels, offset: float = 0.005) -> list[Mark]
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
     towards = np.sign(np.einsum("md,md->m", uv_faces[inside] - mid, normal))[:, None]
     shift = (towards * normal * offset * panels.scale)[:, None, :]
-    return [*seams, Mark("stitch", segments + shift, 0.0008)]
+    # The seam allowance folded under the topstitching: a ridge between seam and stitches.
+    ridge = Mark("fold", segments + 0.5 * shift, 0.0025, ALLOWANCE)
+    return [*seams, ridge, Mark("stitch", segments + shift, 0.0008)]
 
 
 def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
