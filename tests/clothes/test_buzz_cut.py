@@ -89,3 +89,18 @@ def test_cap_is_tucked_down_to_the_skin_at_the_hairline():
     front = hair.around(cap.vertices[rim].astype(np.float64), centre) < 60
     assert front.sum() > 10 and np.median(height[rim][front]) < 0.0005
     assert np.median(np.delete(height, rim)) == pytest.approx(CAP, abs=2e-4)
+
+
+def test_no_speck_of_hair_below_the_temple():
+    """Every scalp face inside the hairline shares an edge with another: the temple's
+    corner left one face of scalp below it, joined by a corner, a speck of hair hanging
+    there (cap and a card) in every buzz cut picture."""
+    from avatar.clothes import hair, library
+
+    body = library.authoring_body()
+    for lift in (0.0, 0.004):  # the cap's and the cards' roots'
+        keep = hair.hairline_mask(body, lift)
+        quads = body.skin_faces[keep]
+        edges = np.sort(np.stack([quads, np.roll(quads, -1, axis=1)], -1).reshape(-1, 2), 1)
+        _, index, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+        assert (counts[index.reshape(-1)] > 1).reshape(-1, 4).any(axis=1).all()

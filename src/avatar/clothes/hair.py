@@ -117,7 +117,21 @@ def hairline_mask(body: AuthoringBody, lift: float = 0.0) -> np.ndarray:
     # The mouth and throat are skin too: keep only faces that look away from the head's axis.
     normal = body.skin_normals[body.skin_faces].mean(axis=1)[:, :2]
     outside = (np.einsum("fd,fd->f", normal, radial) > 0) | (c[:, 2] > eye_z + 0.06)
-    return near & outside & (c[:, 2] > line) & ~ear
+    return _no_lone_faces(body.skin_faces, near & outside & (c[:, 2] > line) & ~ear)
+
+
+def _no_lone_faces(faces: np.ndarray, keep: np.ndarray) -> np.ndarray:
+    """(F,) ``keep`` without the kept faces (F, 4) that share no edge with another kept
+    one: the hairline's corner at the temple left one face of scalp below it, joined by
+    a corner, which hung there as a speck of hair (a buzz cut's most)."""
+    chosen = np.flatnonzero(keep)
+    quads = faces[chosen]
+    edges = np.sort(np.stack([quads, np.roll(quads, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    _, index, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    shared = (counts[index.reshape(-1)] > 1).reshape(len(chosen), 4).any(axis=1)
+    out = keep.copy()
+    out[chosen[~shared]] = False
+    return out
 
 
 CAP_RIM_M = 0.0003  # the cap's rim lies this far off the skin ...
