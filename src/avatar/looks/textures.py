@@ -139,8 +139,9 @@ def brow_alpha(size: int, seed: int = 0) -> np.ndarray:
 
 
 def strand_alpha(size: int, seed: int = 0) -> np.ndarray:
-    """(S, S) uint8 alpha of the hair layout (module docstring): dense strands over the
-    upper half, strands of varying length thinning to the tips over the lower half."""
+    """(S, S) uint8 alpha of the hair layout (module docstring): dense short hairs over
+    the upper half (``SCALP_SHOWS`` of them missing), strands of varying length thinning
+    to the tips over the lower half."""
     rng = np.random.default_rng([seed, size])
     half = size // 2
     cols = np.arange(size)
