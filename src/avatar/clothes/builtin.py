@@ -69,7 +69,7 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
     mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX, sided=bridge)
     mesh = level_hems(mesh)
     if bridge:
-        mesh = spanned(body, bridged(body, mesh))
+        mesh = spread_across(body, spanned(body, bridged(body, mesh)))
     if snug is not None:
         points = tailoring.hug_skin(body, mesh.vertices.astype(np.float64), snug)
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
@@ -122,6 +122,25 @@ def spanned(body: AuthoringBody, mesh: Mesh) -> Mesh:
     between = (share > 0) & (crown >= 0) & (np.abs(v[:, 0]) < v[np.maximum(crown, 0), 0])
     lift = np.where(between, np.clip(v[np.maximum(crown, 0), 1] - v[:, 1], 0, None), 0.0)
     v[:, 1] += share * lift
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+def spread_across(body: AuthoringBody, mesh: Mesh, passes: int = 8) -> Mesh:
+    """Loose cloth over the back's midline with its vertices spaced evenly from side to
+    side (each moved sideways to the middle of its left and right neighbours, a few
+    passes). Cut from the tights shell, the cleft's two walls and its floor came out of
+    ``bridged`` and ``spanned`` 0.4-1.8 mm apart across the cardigan's back above its hem
+    (5 cm apart down the back): the cloth's outer layer, grown along the skin's normals,
+    which face each other across the cleft, crossed its neighbours there, a dark pinch at
+    the hem's midline."""
+    v = mesh.vertices.astype(np.float64)
+    a = mesh.faces.reshape(-1)
+    b = np.roll(mesh.faces, -1, axis=1).reshape(-1)
+    left, right = _side_neighbours(v, np.concatenate([a, b]), np.concatenate([b, a]))
+    near = np.flatnonzero((np.abs(v[:, 0]) < MIDLINE_SPAN / 2) & (v[:, 1] > body.marks.hip[0, 1])
+                          & (left != np.arange(len(v))) & (right != np.arange(len(v))))  # fmt: skip
+    for _ in range(passes):
+        v[near, 0] = (v[left[near], 0] + v[right[near], 0]) / 2
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
@@ -452,7 +471,10 @@ def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
         grid[:, 1:-1] = 0.5 * grid[:, 1:-1] + 0.25 * (grid[:, :-2] + grid[:, 2:])
         grid[1:-1] = 0.5 * grid[1:-1] + 0.25 * (grid[:-2] + grid[2:])
     edge = np.abs(np.broadcast_to(u, (down, across)))
-    rim = np.exp(-(((1 - edge) / 0.22) ** 2)) * np.clip(d * 4, 0, 1)  # the rolled opening
+    # The rolled opening runs down the sides and fades out over the lower third, where the
+    # bag folds round onto the back: rolled all the way round its point, a valley between
+    # the roll and the bag's dome ran along the lower edge (a crease from behind).
+    rim = np.exp(-(((1 - edge) / 0.22) ** 2)) * np.clip(d * 4, 0, 1) * _fade(d, HOOD_ROLL)
     pouch = np.sin(np.pi * np.clip(d, 0, 1)) ** 0.8  # the hood's bag lying on the back
     # Domed across as well as down: the bag's two layers hold air, up to 4 cm over the
     # back, settling to the rolled rim at its outline (over the hoodie: 2.1 cm at least).
@@ -466,6 +488,15 @@ def _hood(body: AuthoringBody, across: int = 25, down: int = 22) -> Piece:
     mesh = orient_outward(body, points.astype(np.float32), faces)
     mesh = banded(with_box_uvs(mesh), 0.022, 0.003)
     return bound(body, mesh, body.group_faces("helper-tights"))
+
+
+HOOD_ROLL = 0.65  # depth (0 at the neck, 1 at the tip) down to which the hood's rim rolls
+
+
+def _fade(d: np.ndarray, end: float) -> np.ndarray:
+    """1 down to depth ``end``, smoothly 0 at the tip (depth 1)."""
+    t = np.clip((d - end) / (1 - end), 0, 1)
+    return 1 - t * t * (3 - 2 * t)
 
 
 def _drawstrings(body: AuthoringBody, length: float = 0.2, radius: float = 0.0028) -> Piece:
