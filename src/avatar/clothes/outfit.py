@@ -13,7 +13,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_matrix
+from scipy.sparse import csc_matrix, csr_matrix
 
 from avatar.body.model import BODY_VERTICES
 from avatar.clothes.contacts import REMOTE_K, remote_contacts
@@ -165,7 +165,7 @@ class _FrameLayout:
     outer_bary: np.ndarray
     outer_need: np.ndarray
     shell_cloth: _ShellCloth  # the shells' faces, for their normals in a frame
-    spread: csr_matrix  # (S, S) a shell point's push shared with its cloth neighbours
+    spread: csc_matrix  # (S, S) a shell point's push shared with its cloth neighbours
     pair_inner: np.ndarray  # (S,) the remote rows of each shell point's inner and outer layer
     pair_outer: np.ndarray
     remote_order: np.ndarray  # rows of [inner; outer] in output order (inner, outer per garment)
@@ -326,6 +326,7 @@ def _keep_apart(joined: np.ndarray, lay: _FrameLayout, cloth: np.ndarray) -> Non
 
 
 SPREAD_PASSES = 2  # neighbour averages a shell point's push is shared over (rings of cloth)
+SPREAD_LEAST = 5e-4  # m: shorter pushes are left alone (no visible step)
 
 
 def _spread_pushes(body: collision.PosedBody, lay: _FrameLayout, points: np.ndarray,
@@ -348,24 +349,25 @@ def _spread_pushes(body: collision.PosedBody, lay: _FrameLayout, points: np.ndar
     return out
 
 
-def _shared(spread: csr_matrix, push: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _shared(spread: csc_matrix, push: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Points' pushes (S, 3) shared with their cloth neighbours by ``spread`` (S, S):
     (T,) the points whose neighbourhood's mean push is longer than their own and (T, 3)
     that push (a point keeps its own push where it is the longer)."""
     size = np.einsum("nd,nd->n", push, push)
-    if spread.shape[0] == 0 or not (size > 1e-10).any():
+    moved = np.flatnonzero(size > SPREAD_LEAST**2)
+    if len(moved) == 0:
         return np.zeros(0, np.intp), np.zeros((0, 3), np.float32)
-    shared = np.asarray(spread @ push, np.float32)
+    shared = np.asarray(spread[:, moved] @ push[moved], np.float32)
     take = np.flatnonzero(np.einsum("nd,nd->n", shared, shared) > size + 1e-10)
     return take, shared[take]
 
 
-def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csr_matrix:
+def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csc_matrix:
     """(S, S) float32 ``SPREAD_PASSES`` averages of each shell row with its edge neighbours
     (faces: each shell's (F_i, C) faces as colliding rows; shell: (S,) those rows)."""
     n = len(shell)
     if not faces:
-        return csr_matrix((n, n), dtype=np.float32)
+        return csc_matrix((n, n), dtype=np.float32)
     joined = np.concatenate(faces)
     where = np.full(int(max(joined.max(), shell.max())) + 1, -1, np.intp)
     where[shell] = np.arange(n)
@@ -381,7 +383,7 @@ def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csr_matrix:
     out = step
     for _ in range(SPREAD_PASSES - 1):
         out = out @ step
-    return csr_matrix(out, dtype=np.float32)
+    return csc_matrix(out, dtype=np.float32)  # columns: the few pushed points' shares
 
 
 def _top_bone(weights: SkinWeights, rows: np.ndarray) -> np.ndarray:
