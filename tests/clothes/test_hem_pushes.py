@@ -33,11 +33,12 @@ def _fold_degrees(v: np.ndarray, faces: np.ndarray, a: np.ndarray, b: np.ndarray
 
 
 def test_a_hem_pushed_by_the_calf_bends_round_it_not_at_one_point():
-    """The back leg's calf sweeps into a short flared hem early in the stride; each hem
-    point was pushed out of it on its own (8-40 mm) while its neighbours stayed, and two
-    faces of the cloth met at 43-56 degrees more than at rest (a faceted flap at the hem).
-    Each point's push is now shared with the cloth round it: within 12 cm of the hem no
-    two faces of one layer turn more than 48 degrees against each other from rest."""
+    """The back leg's calf sweeps into a child's flared hem early in the stride; each hem
+    point was pushed out of it on its own (8 and 15 mm) while its neighbours stayed, and
+    two faces of the cloth turned 43 and 56 degrees against each other from rest (a
+    faceted flap at the hem; 33 and 41 now). Each point's push is now shared with the
+    cloth round it: within 12 cm of the hem no two faces of one layer turn more than 48
+    degrees against each other from rest."""
     human = Human(CHILD).dressed("dress")
     fitted = human.outfit.garments[0]
     count = len(fitted.garment.mesh.vertices)

@@ -14,7 +14,7 @@ ELDERLY_WOMAN = {"gender": 0.0, "age": 0.95, "weight": 0.6}
 
 @pytest.mark.parametrize("params", [ELDERLY_WOMAN, {"gender": 0.0, "age": 0.9, "weight": 0.7}])
 def test_cardigan_layers_keep_their_order_across_the_back_midline(params):
-    """The cleft's walls and floor came out of the tights shell 0.4-1.8 mm apart across
+    """The cleft's walls and floor came out of the tights shell 1.5-1.8 mm apart across
     the cardigan's back above its hem; the outer layer, grown along the skin's normals
     (which face each other across the cleft), put a vertex's outer point past its
     neighbour's: the layers crossed, a dark pinch at the hem's midline. Within 4 cm of the

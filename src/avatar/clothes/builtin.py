@@ -129,7 +129,7 @@ def spread_across(body: AuthoringBody, mesh: Mesh, passes: int = 8) -> Mesh:
     """Loose cloth over the back's midline with its vertices spaced evenly from side to
     side (each moved sideways to the middle of its left and right neighbours, a few
     passes). Cut from the tights shell, the cleft's two walls and its floor came out of
-    ``bridged`` and ``spanned`` 0.4-1.8 mm apart across the cardigan's back above its hem
+    ``bridged`` and ``spanned`` 1.5-1.8 mm apart across the cardigan's back above its hem
     (5 cm apart down the back): the cloth's outer layer, grown along the skin's normals,
     which face each other across the cleft, crossed its neighbours there, a dark pinch at
     the hem's midline."""
