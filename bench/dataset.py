@@ -1,7 +1,7 @@
 """Dataset throughput and memory, against anchors measured in the same run.
 
     python bench/dataset.py [--count 16] [--resolution 256] [--samples 16] [--rss 0]
-                            [--repeat 1] [--overhead-only]
+                            [--repeat 1] [--overhead-only | --workers-only]
 
 1. label overhead: samples/s with every label against the anchor, a bare Cycles render of
    the same scenes (same people, camera, lights; RGB only), on one worker in-process, and
@@ -175,6 +175,8 @@ def main() -> int:
     parser.add_argument("--repeat", type=int, default=1, help="rounds of the workers' rates")
     parser.add_argument("--overhead-only", action="store_true",
                         help="only the label overhead (part 1)")
+    parser.add_argument("--workers-only", action="store_true",
+                        help="only the workers and engines (parts 2 and 3)")
     args = parser.parse_args()
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
     with tempfile.TemporaryDirectory() as tmp:
@@ -199,13 +201,22 @@ def main() -> int:
 
 
 def _throughput(args, root: Path) -> None:
+    if not args.workers_only:
+        _overhead(args, root)
+    if args.overhead_only:
+        return
+    _workers(args, root)
+
+
+def _overhead(args, root: Path) -> None:
     bare, labelled, paired, label_pass = bare_vs_labelled(args, root / "inproc")
     print(f"bare Cycles render (anchor): {bare:.2f} s/sample; with every label: "
           f"{labelled:.2f} s/sample; label overhead {100 * (labelled / bare - 1):.0f}% "
           f"(median of the {args.count} pairs: {100 * (paired - 1):.0f}%); the label pass "
           f"itself {label_pass:.3f} s/sample")  # fmt: skip
-    if args.overhead_only:
-        return
+
+
+def _workers(args, root: Path) -> None:
     share = max(1, (os.cpu_count() or 1) // 2)
     rounds = []
     for r in range(args.repeat):
