@@ -120,7 +120,7 @@ def test_cache_stays_bounded_when_an_old_entry_shares_a_material_in_use():
         stage.trim(used={shared.name_full, stage.get(other).name_full})
         assert len(stage._cache) <= 2, len(stage._cache)
         assert shared.name_full in bpy.data.materials  # in use: kept
-    del parts, base, copy, other
+    del parts, base, copy, other, twin, m  # every array the entries refer to
     gc.collect()
     stage.trim(used=set())  # every record is gone: nothing can be hit, nothing is kept
     assert stage.names() == set()
