@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar.clothes import disk_cache
 from avatar.dataset import config as dataset_config
 from avatar.dataset import people, runner, sampling, worker
 
@@ -95,6 +96,10 @@ def rate(args, workers: int, engine: str, folder: Path,
         # and OpenMP searches would otherwise also use the core the other worker has.
         os.sched_setaffinity(0, sorted(cores)[:threads])
     shutil.rmtree(folder, ignore_errors=True)
+    # Every run starts with an empty garment cache of its own: each pays the builds once,
+    # as a fresh dataset run on a fresh machine does (its workers share them).
+    os.environ[disk_cache.ENV_ROOT] = str(folder.with_name(folder.name + "-garments"))
+    shutil.rmtree(os.environ[disk_cache.ENV_ROOT], ignore_errors=True)
     start = time.perf_counter()
     try:
         with runner.thread_limits(threads or 0):
@@ -181,6 +186,7 @@ def main() -> int:
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="avatar-bpy-"))
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
+        os.environ[disk_cache.ENV_ROOT] = str(root / "garments")  # leave the user's alone
         print(f"{args.count} samples, {args.resolution}x{args.resolution}, {args.samples} spp, "
               f"{os.cpu_count()} CPUs, Python {sys.version.split()[0]}")  # fmt: skip
         if args.count == 0:  # --count 0: the memory curve only

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from avatar.body.model import BodyModel
 from avatar.body.shaped import Body, default_body
-from avatar.clothes import builtin, fitting, variants
+from avatar.clothes import builtin, disk_cache, fitting, variants
 from avatar.clothes.asset import read_garment
 from avatar.clothes.authoring import AuthoringBody
 from avatar.clothes.fitting import FittedGarment, Garment, Outfit
@@ -131,8 +131,14 @@ def _piece(name: str, model: BodyModel | None):
 
 @lru_cache(maxsize=64)
 def _builtin(name: str, texture_size: int, model: BodyModel | None) -> Garment:
-    spec = builtin.BY_NAME[name]
-    return builtin.build(spec, authoring_body(model), texture_size, _piece(name, model))
+    """A built-in garment, built once per process (or read from ``disk_cache`` when a
+    dataset worker enabled it)."""
+
+    def build() -> Garment:
+        spec = builtin.BY_NAME[name]
+        return builtin.build(spec, authoring_body(model), texture_size, _piece(name, model))
+
+    return disk_cache.fetch(("builtin", name, texture_size, _assets_key(model)), build)
 
 
 @lru_cache(maxsize=64)
@@ -140,9 +146,18 @@ def _variant(name: str, options: tuple[tuple[str, str], ...], texture_size: int,
              model: BodyModel | None) -> Garment:  # fmt: skip
     """A built-in in a fabric/colour variant: the default's geometry and binding (the same
     arrays), a material of its own, made once per (garment, variant)."""
-    spec = variants.spec(name, dict(options))
-    look = builtin.look(spec, _piece(name, model).layout, texture_size)
-    return replace(_builtin(name, texture_size, model), material=look)
+
+    def look():
+        spec = variants.spec(name, dict(options))
+        return builtin.look(spec, _piece(name, model).layout, texture_size)
+
+    key = ("look", name, options, texture_size, _assets_key(model))
+    return replace(_builtin(name, texture_size, model), material=disk_cache.fetch(key, look))
+
+
+def _assets_key(model: BodyModel | None) -> str:
+    """The MakeHuman assets a built-in is cut from (their compiled folder's fingerprint)."""
+    return (model or BodyModel.shared()).assets.folder.name
 
 
 # find_garment's answers: (name or path, folders, $AVATAR_CLOTHES_PATH) -> the .mhclo path
@@ -275,7 +290,10 @@ def _pressed(garment: Garment, name: str, model: BodyModel | None) -> Garment:
 def _pressed_piece(name: str, model: BodyModel | None):
     from avatar.clothes import headwear
 
-    return headwear.pressed_hair(authoring_body(model), _piece(name, model))
+    def build():
+        return headwear.pressed_hair(authoring_body(model), _piece(name, model))
+
+    return disk_cache.fetch(("pressed", name, _assets_key(model)), build)
 
 
 # Built-ins that follow their wearer's hair colour and age, and how (``for_wearer``'s kind);

@@ -3,7 +3,9 @@
 ``render_sample(config, index, out)`` draws sample ``index`` (``sampling.sample``), poses its
 people (``people.pose_person``), stages and renders them (``avatar.blender.labels``), derives
 the annotations (``annotate``) and writes the sample's files, then returns its manifest
-entry. The parent appends that entry; see ``store`` for why a kill loses nothing.
+entry. The parent appends that entry; see ``store`` for why a kill loses nothing. Workers
+share their garment builds through ``clothes.disk_cache`` (each process would otherwise
+build the same garments again, and again after every recycle).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 
 from avatar.body.shaped import PART_GROUPS
 from avatar.camera import intrinsics, world_to_camera
+from avatar.clothes import disk_cache
 from avatar.dataset import annotate, people, sampling, store
 from avatar.dataset.config import Config, avatar_version
 from avatar.io import exr
@@ -33,6 +36,8 @@ def render_sample(config: Config, index: int, out: str | Path, threads: int = 0)
     from avatar.blender import labels as blender_labels
 
     out = Path(out)
+    if not _STAGE:  # this process's first sample: share garment builds with the others
+        disk_cache.enable()
     spec = sampling.sample(config, index)
     posed = [people.pose_person(person) for person in spec.people]
     items = []
