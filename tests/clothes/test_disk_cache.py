@@ -98,7 +98,12 @@ def test_an_unwritable_cache_still_returns_the_build(tmp_path, caplog):
         disk_cache.disable()
 
 
-def test_old_code_versions_are_pruned(tmp_path):
+def test_old_code_versions_and_killed_writes_are_pruned(tmp_path):
+    current = tmp_path / disk_cache.code_fingerprint()
+    current.mkdir()
+    (current / ".a.pickle.1.tmp").write_bytes(b"half")  # a writer killed long ago
+    os.utime(current / ".a.pickle.1.tmp", (1000, 1000))
+    (current / ".b.pickle.2.tmp").write_bytes(b"half")  # one writing now
     for i in range(5):
         old = tmp_path / f"old{i}"
         old.mkdir()
@@ -107,6 +112,7 @@ def test_old_code_versions_are_pruned(tmp_path):
     disk_cache.disable()
     kept = sorted(p.name for p in tmp_path.iterdir())
     assert kept == sorted([folder.name, "old4", "old3"][: disk_cache.KEEP_OLD + 1])
+    assert [p.name for p in folder.iterdir()] == [".b.pickle.2.tmp"]
 
 
 def test_off_unless_enabled():

@@ -26,6 +26,7 @@ import logging
 import os
 import pickle
 import shutil
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
@@ -36,6 +37,7 @@ log = logging.getLogger(__name__)
 T = TypeVar("T")
 ENV_ROOT = "AVATAR_GARMENT_CACHE"
 KEEP_OLD = 2  # other code versions' folders kept (e.g. two checkouts in use); older go
+STALE_TMP_S = 600  # s; a temporary file this old was left by a killed writer (a write: ~0.1 s)
 _FOLDER: list[Path] = []  # the enabled folder, if any
 
 
@@ -112,14 +114,19 @@ def code_fingerprint() -> str:
 
 
 def _prune(current: Path) -> None:
+    """Drop old code versions' folders and temporary files a killed writer left behind."""
+    now = time.time()
+    for tmp in current.glob(".*.tmp"):
+        if now - _used(tmp) > STALE_TMP_S:
+            tmp.unlink(missing_ok=True)
     others = [p for p in current.parent.iterdir() if p.is_dir() and p != current]
     others.sort(key=_used, reverse=True)
     for old in others[KEEP_OLD:]:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def _used(folder: Path) -> float:
+def _used(path: Path) -> float:
     try:
-        return folder.stat().st_mtime
+        return path.stat().st_mtime
     except OSError:  # another process pruned it meanwhile
         return 0.0
