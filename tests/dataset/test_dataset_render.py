@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from avatar.clothes import disk_cache
+
 pytestmark = pytest.mark.skipif(
     importlib.util.find_spec("bpy") is None or importlib.util.find_spec("OpenEXR") is None
     or importlib.util.find_spec("pycocotools") is None,
@@ -53,13 +55,22 @@ def dataset(tmp_path_factory, model):
     out = tmp_path_factory.mktemp("ds")
     (out.parent / "ds.toml").write_text(CONFIG)
     c = config.load(out.parent / "ds.toml")
+    # an empty garment cache: this run builds every garment and writes it; the resumed run
+    # below reads them back, and its labels must equal these bytes
+    saved = os.environ.get(disk_cache.ENV_ROOT)
+    os.environ[disk_cache.ENV_ROOT] = str(out / "garments")
     report = runner.run(c, out / "set", workers=1, config_text=CONFIG)
     assert report.rendered == 3 and not report.failed, report.failed
+    assert len(list((out / "garments").rglob("*.pickle"))) >= 4  # the workers' builds
     # when each sample came in: rising, within the run (the steady rate is timed on them)
     times = report.finished_at
     assert len(times) == 3 and 0 < times[0] < times[1] < times[2] <= report.seconds
     assert report.steady_rate(1) == pytest.approx(2 / (times[2] - times[0]))
-    return c, out / "set"
+    yield c, out / "set"
+    if saved is None:
+        os.environ.pop(disk_cache.ENV_ROOT, None)
+    else:
+        os.environ[disk_cache.ENV_ROOT] = saved
 
 
 def _posed(c, index):
@@ -180,11 +191,15 @@ def test_parts_label_skin_and_clothes_of_each_person(dataset):
 
 def test_killed_run_resumes_to_the_same_labels(dataset, tmp_path):
     """SIGKILL the command mid-run, run it again: the set equals the clean run's (same
-    label bytes), with no duplicate or partial sample."""
+    label bytes), with no duplicate or partial sample. Its workers read the garments the
+    clean run built from the cache on disk, so the bytes also show a cached garment renders
+    as a built one."""
     c, clean = dataset
     config_path = tmp_path / "ds.toml"
     config_path.write_text(CONFIG)
     out = tmp_path / "set"
+    cache = Path(os.environ[disk_cache.ENV_ROOT])
+    builds = {p: p.stat().st_mtime_ns for p in cache.rglob("*.pickle")}
     cmd = [sys.executable, "-m", "avatar.cli", "dataset", "run", str(config_path), "-o", str(out)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                             start_new_session=True)  # fmt: skip
@@ -209,6 +224,8 @@ def test_killed_run_resumes_to_the_same_labels(dataset, tmp_path):
             a = (clean / "samples" / f"{i:08d}" / name).read_bytes()
             b = (out / "samples" / f"{i:08d}" / name).read_bytes()
             assert a == b, (i, name)
+    # the workers read the clean run's builds: nothing built or written again
+    assert {p: p.stat().st_mtime_ns for p in cache.rglob("*.pickle")} == builds
 
 
 def test_workers_share_the_cores_out_among_their_renders():
