@@ -127,3 +127,45 @@ def test_a_pair_is_about_eight_thousand_triangles(body):
     assert _triangles("shoes", body) < 8700
     assert _triangles("sneakers", body) < 8900
     assert _triangles("boots", body) < 12000
+
+
+def _sneaker_proportions(params: dict) -> tuple[float, float]:
+    """(tread under the foot, toe box past the toes) of the left sneaker as worn, over
+    the foot's length."""
+    from avatar.human import Human
+
+    human = Human(params).dressed("sneakers")
+    worn = human.outfit.garments[0]
+    shell = worn.mesh.vertices[len(worn.garment.mesh.vertices) :].astype(np.float64)
+    shoe = shell[shell[:, 0] > 0]
+    skin = human.vertices[:13380].astype(np.float64)
+    foot = skin[(skin[:, 0] > 0) & (skin[:, 2] < skin[:, 2].min() + 0.12)]
+    length = np.ptp(foot[:, 1])
+    under = foot[:, 2].min() - shoe[:, 2].min()
+    past = foot[:, 1].min() - shoe[:, 1].min()
+    return under / length, past / length
+
+
+def test_a_childs_sneakers_are_scaled_by_the_foot():
+    """A child's sneaker in the adult's proportions to the foot, within 15% (its sole was
+    28% and its toe box 39% deeper for the foot than an adult's: offsets scaled by the
+    head, which is large on a child)."""
+    adult = _sneaker_proportions({"gender": 1.0, "age": 0.5})
+    child = _sneaker_proportions({"gender": 0.3, "age": 0.12})
+    assert child[0] < 1.15 * adult[0] and child[1] < 1.15 * adult[1], (child, adult)
+
+
+def test_boot_shaft_follows_the_leg_to_a_flared_collar(body, foot):
+    """A boot's shaft lies 6-7 mm off the leg round the ankle and up the calf (it stood a
+    tube 10-11 mm off it all the way up) and flares out at its collar (2 mm and more
+    wider off the leg than at the ankle; it was 0.6 mm)."""
+    mesh = shoes.upper(body, foot, 0.86).mesh
+    v = mesh.vertices.astype(np.float64)
+    _, i = body.skin_tree.query(v)
+    normal = body.skin_normals[i].astype(np.float64)
+    gap = np.einsum("nd,nd->n", v - body.vertices[i], normal)
+    z = v[:, 2] - foot.ground
+    ankle = gap[(z > 0.1) & (z < 0.14)]
+    collar = gap[z > z.max() - 0.006]
+    assert ankle.max() < 0.008 and ankle.min() > shoes.EASE
+    assert np.median(collar) - np.median(ankle) > 0.002

@@ -135,7 +135,34 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     faces = body.group_faces("helper-tights")
     mesh = cut(body, faces, _shoe_faces(body, foot, faces, top), EASE, relax=10)
     mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, EASE))
+    if top <= LOW:
+        mesh = _shaft(body, foot, mesh)
     return bound(body, _planar_uvs(mesh, "upper"), faces)
+
+
+# A boot's shaft above the last: SHAFT_EASE m off the skin round the ankle and up the leg,
+# flaring out COLLAR m more over its top COLLAR_DEPTH m (a padded collar). Cut from the
+# tights shell it stood a straight tube 10-13 mm off the leg all the way up.
+SHAFT_EASE = 0.0065
+COLLAR = 0.004
+COLLAR_DEPTH = 0.025
+
+
+def _shaft(body: AuthoringBody, foot: Foot, mesh: Mesh) -> Mesh:
+    """The upper with its shaft (above the last, ``SHAPED_TO``) laid SHAFT_EASE off the
+    leg along the skin's normals, its collar flared."""
+    v = mesh.vertices.astype(np.float64)
+    z = v[:, 2] - foot.ground
+    w = np.clip((z - SHAPED_TO[0]) / (SHAPED_TO[1] - SHAPED_TO[0]), 0, 1)
+    w = w * w * (3 - 2 * w)
+    flare = np.clip((z - (z.max() - COLLAR_DEPTH)) / COLLAR_DEPTH, 0, 1)
+    target = SHAFT_EASE + COLLAR * flare * flare * (3 - 2 * flare)
+    for _ in range(2):  # twice: the nearest skin vertex changes as the shaft moves in
+        _, i = body.skin_tree.query(v)
+        normal = body.skin_normals[i].astype(np.float64)
+        gap = np.einsum("nd,nd->n", v - body.vertices[i], normal)
+        v -= (w * (gap - target))[:, None] * normal
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float,
@@ -329,8 +356,9 @@ def _resampled(ring: np.ndarray, n: int) -> np.ndarray:
 
 
 # The sole's rings' places in its atlas row (0 the tread's middle, 1 the edge tucked under
-# the upper): the welt's top lip spans 0.9-1, the wall 0.1-0.9.
-SOLE_RINGS = (1.0, 0.9, 0.1, 0.05)
+# the upper): the welt's top lip spans 0.9-1, the wall 0.1-0.9 (its belly, a third of the
+# way down, at 0.63).
+SOLE_RINGS = (1.0, 0.9, 0.63, 0.1)
 
 
 def sole_v(place: float) -> float:
@@ -635,7 +663,23 @@ def shoes(body: AuthoringBody, top: float = 0.96, style: Style = SHOE) -> Piece:
                    *lacing(body, foot, top_piece, style)]  # fmt: skip
         if style.heel_tab:
             pieces.append(heel_tab(body, foot, top_piece))
-    return join(pieces)
+    return _scaled_by_the_foot(body, join(pieces))
+
+
+def _scaled_by_the_foot(body: AuthoringBody, piece: Piece) -> Piece:
+    """The shoes with their offsets scaled by the foot (its width, length and height), not
+    by the head (``bound``'s pairs, MakeHuman's default): a child's head is large for its
+    feet, so a child's soles, welts and toe boxes came out a third too thick."""
+    from avatar.clothes.binding import make_binding
+
+    skin = body.vertices[: len(body.part)]
+    foot = np.flatnonzero((body.part == "foot") & (skin[:, 0] > 0))
+    p = skin[foot]
+    refs = np.array([[foot[np.argmin(p[:, k])], foot[np.argmax(p[:, k])]] for k in range(3)])
+    lengths = np.ptp(p, axis=0).astype(np.float64)
+    b = piece.binding
+    binding = make_binding(b.indices, b.weights, b.offsets, refs, lengths, b.single)
+    return Piece(piece.mesh, binding, piece.layout)
 
 
 CAP_OVERLAP = 0.012  # m the upper runs on under the toe cap past its seam
