@@ -171,7 +171,9 @@ def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float,
     the last (``_Last``), still ``ease`` off the skin; ``smooth_rim``: passes smoothing
     the cut (its boundary along itself, the rest after it) before it goes on the last
     again, so a seam runs in a curve, not in whole faces' steps."""
-    mesh = _subdivided(mesh)
+    # Split finer only where the last shapes it (a boot's shaft above stays as cut).
+    low = mesh.vertices[mesh.faces, 2].min(axis=1) < foot.ground + SHAPED_TO[1]
+    mesh = _subdivided(mesh, low)
     last = _Last(body, foot, ease)
     points = last.shape(mesh.vertices.astype(np.float64))
     if smooth_rim:
@@ -904,21 +906,43 @@ def _smoothed(faces: np.ndarray, points: np.ndarray, passes: int) -> np.ndarray:
     return p
 
 
-def _subdivided(mesh: Mesh) -> Mesh:
-    """Each quad split in four (edge midpoints, face centre): room for the last's edges."""
+def _subdivided(mesh: Mesh, refine: np.ndarray | None = None) -> Mesh:
+    """Quads split in four (edge midpoints, face centre): room for the last's edges.
+    ``refine`` (F,) bool: only these (None: all), grown until no other face has two split
+    edges; a face with one split edge becomes a quad and a triangle (no T-junctions)."""
     v = mesh.vertices.astype(np.float64)
     f = mesh.faces
     edges = np.sort(np.stack([f, np.roll(f, -1, axis=1)], -1).reshape(-1, 2), axis=1)
     unique, inverse = np.unique(edges, axis=0, return_inverse=True)
     inverse = inverse.reshape(f.shape)
-    mids = v[unique].mean(axis=1)
-    centres = v[f].mean(axis=1)
-    e0, c0 = len(v), len(v) + len(unique)
+    refine = np.ones(len(f), bool) if refine is None else refine.copy()
+    while True:
+        split = np.zeros(len(unique), bool)
+        split[inverse[refine].ravel()] = True
+        grow = ~refine & (split[inverse].sum(axis=1) >= 2)
+        if not grow.any():
+            break
+        refine |= grow
+    edge_vertex = np.cumsum(split) - 1 + len(v)  # the new vertex of each split edge
+    mids = v[unique[split]].mean(axis=1)
+    fine = np.flatnonzero(refine)
+    c0 = len(v) + len(mids)
     faces = []
     for k in range(4):  # corner k, the edge after it, the centre, the edge before it
-        faces.append(np.stack([f[:, k], e0 + inverse[:, k], c0 + np.arange(len(f)),
-                               e0 + inverse[:, (k - 1) % 4]], 1))  # fmt: skip
-    points = np.concatenate([v, mids, centres]).astype(np.float32)
+        faces.append(np.stack([f[fine, k], edge_vertex[inverse[fine, k]],
+                               c0 + np.arange(len(fine)),
+                               edge_vertex[inverse[fine, (k - 1) % 4]]], 1))  # fmt: skip
+    coarse = np.flatnonzero(~refine)
+    cut_edge = split[inverse[coarse]]  # (C, 4) at most one per face
+    faces.append(f[coarse[~cut_edge.any(axis=1)]])
+    for k in range(4):  # corner k, its split edge's middle m, then the others: quad + triangle
+        one = coarse[cut_edge[:, k]]
+        if len(one):
+            m = edge_vertex[inverse[one, k]]
+            c = [f[one, (k + j) % 4] for j in range(4)]
+            faces.append(np.stack([c[0], m, c[2], c[3]], 1))
+            faces.append(np.stack([m, c[1], c[2], c[2]], 1))
+    points = np.concatenate([v, mids, v[f[fine]].mean(axis=1)]).astype(np.float32)
     return Mesh(points, np.concatenate(faces).astype(np.int32))
 
 
