@@ -1,25 +1,32 @@
 """Shoes built from the foot: a leather upper, a rubber sole with a heel block, a toe cap
-and laces, all generated on the authoring body and bound to it, so they fit every foot.
+and laces, all generated on the authoring body and bound to it, so they fit every foot
+(their offsets scaled by the foot's size, ``_scaled_by_the_foot``).
 
 Parts, per foot (``x > 0`` is the body's left):
 
 - upper: the ``helper-tights`` faces of the foot and ankle, eased off the skin, its
-  opening smoothed into a curve, split finer and moved onto a last (``_Last``): the
-  foot's outline in plan with upright walls (a vertical heel counter, straight sides
-  down to the sole), rolling over onto a vamp that runs straight down to an almond toe
-  box past the toes; the bottom edge drawn down to just above the ground;
-- sole: a thin edge (``_sole_edge``) round the upper's bottom edge, out by a welt, down to
-  a tread a little below the foot, taller at the heel (a heel block), lifted under the
-  arch and curling up at the toe (toe spring), closed underneath;
+  opening smoothed into a curve, split finer (where the last shapes it) and moved onto a
+  last (``_Last``): the foot's outline in plan with upright walls (a vertical heel
+  counter, straight sides down to the sole), rolling over onto a vamp that runs straight
+  down over the toes and on, steepening, to a low almond toe box; the bottom edge drawn
+  down to just above the ground. A boot's shaft above the last is laid close round the
+  ankle and leg, flaring at its collar (``_shaft``). As worn (``capped``) it has no faces
+  under the toe cap, and its throat ends just over the top eyelets;
+- sole: an outsole round the upper's bottom edge (resampled to SOLE_POINTS), a thin welt
+  out, its wall bellied and bevelled in under the tread (``_sole_edge``), a little below
+  the foot, taller at the heel (a heel block with a breast: the waist lifted under the
+  arch), curling up at the toe (toe spring), closed underneath;
 - toe cap: the front of the upper again, on the same last 1.2 mm out, its back edge
-  (the seam over the vamp) smoothed into a curve and double-stitched;
-- lacing (``lacing``): a tongue under the laces, two quarters' facings either side of it
-  with eyelets, and one lace criss-crossing from eyelet to eyelet (each crossing over the
-  one before), tied in a bow at the top;
+  (the seam over the vamp) smoothed into a curve, skived down onto the vamp
+  (``_skived``) and double-stitched;
+- lacing (``lacing``): a tongue lying on the instep under the laces, two quarters'
+  facings either side of it with eyelets, and one lace criss-crossing from eyelet to
+  eyelet (each crossing over the one before), tied in a bow at the top;
 - a sneaker (``SNEAKER``) on a deep rubber midsole wrapping up over the toe (a toe
   bumper), with a band moulded round it, and a heel tab.
 
-They share one material: an atlas (``look``) whose rows hold leather, trim (eyelets, a
+They share one material: an atlas (``look``) whose rows hold leather (grained:
+``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), trim (eyelets, a
 sneaker's facings and heel tab), toe-cap leather, sole and lace cord, each piece's UVs
 laid out inside its row; the toe cap's and sole's UVs run from their seams, so stitching
 drawn across the atlas follows the cap's edge and the welt.
