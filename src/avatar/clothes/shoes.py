@@ -407,6 +407,7 @@ def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot,
 # under it sank into it in patches (navy facings as blotches on a sneaker).
 TONGUE_LIFT, FACING_LIFT, EYELET_LIFT, LACE_LIFT = 0.001, 0.002, 0.0026, 0.0032
 LACE_WIDTH = 0.0035
+SKIVED_END = 0.0003  # m a tongue's or facing's front end stands over the upper
 TONGUE_OVER = 0.003  # m the tongue's top stands over the top eyelets
 BOW_OVER = 0.005  # m the bow's loops reach over the top eyelets (flopped on the instep)
 LACE_ROWS = (0.72, 0.47)  # along the foot: the lowest eyelets (towards the toes), the top
@@ -509,9 +510,14 @@ def _ribbon(points: np.ndarray, normals: np.ndarray, width: float, crown: float)
 
 
 def _sheet(surface: _Surface, xy: np.ndarray, lift: float) -> Mesh | None:
-    """A grid (R, C, 2) of xy laid ``lift`` m over the upper (rows missing it dropped)."""
+    """A grid (R, C, 2) of xy laid ``lift`` m over the upper (rows missing it dropped),
+    its first row (the front end, towards the toes) sunk to SKIVED_END over it: a step
+    the leather's thickness over the vamp caught the light as a pale lip."""
     r, c = xy.shape[:2]
-    points, _, found = surface.over(xy.reshape(-1, 2), lift)
+    points, normal, found = surface.over(xy.reshape(-1, 2), 0.0)
+    rows = np.full(r, lift)
+    rows[0] = min(lift, SKIVED_END)
+    points = points + np.repeat(rows, c)[:, None] * normal
     keep = found.reshape(r, c).all(axis=1)
     if keep.sum() < 2:
         return None
