@@ -99,14 +99,14 @@ def _high_frequency(normal: np.ndarray) -> float:
 
 
 def test_leather_is_grained_and_sneakers_are_textile(body):
-    """A pebble grain in the leather's normal map (fine detail 0.097, twice what it was),
+    """A pebble grain in the leather's normal map (fine detail 0.085, was 0.049),
     its gloss varying (roughness spread 0.04, was 0.016; mean 0.49, was 0.35); the
     sneaker's canvas an open mesh in colour (a 35-level spread, was 3) and normal map."""
     size = 512
     shoe = builtin.build(builtin.BY_NAME["shoes"], body, size).material
     rows = slice(int((1 - shoes.ROWS["upper"][1]) * size) + 4,
                  int((1 - shoes.ROWS["upper"][0]) * size) - 4)  # fmt: skip
-    assert _high_frequency(shoe.normal_texture[rows]) > 0.08
+    assert _high_frequency(shoe.normal_texture[rows]) > 0.07
     rough = shoe.roughness_texture[rows].astype(float) / 255
     assert rough.std() > 0.03 and rough.mean() > 0.42
     sneaker = builtin.build(builtin.BY_NAME["sneakers"], body, size).material

@@ -996,7 +996,7 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
             _moulded_band(m, fabrics.rgb(band), size)
         for row in ("upper", "cap"):
             if upper in LEATHERS:
-                _grained(m, ROWS[row], size)
+                _grained(m, ROWS[row], size, GRAIN_STRETCH[row])
             else:
                 _knit_mesh(m, ROWS[row], size)
         return m
@@ -1019,11 +1019,14 @@ def _rows(span: tuple[float, float], size: int) -> slice:
     return slice(int(round((1 - span[1]) * size)), int(round((1 - span[0]) * size)))
 
 
-def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], cell: int) -> np.ndarray:
-    """(H, W) noise in [-1, 1]: random values every ``cell`` texels, smoothly interpolated."""
+def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], cell: int,
+                  stretch: float = 1.0) -> np.ndarray:  # fmt: skip
+    """(H, W) noise in [-1, 1]: random values every ``cell`` texels across (``stretch`` x
+    ``cell`` down the rows), smoothly interpolated."""
     h, w = shape
-    coarse = rng.uniform(-1, 1, (h // cell + 2, w // cell + 2))
-    y, x = np.arange(h) / cell, np.arange(w) / cell
+    down = cell * stretch
+    coarse = rng.uniform(-1, 1, (int(h // down) + 2, w // cell + 2))
+    y, x = np.arange(h) / down, np.arange(w) / cell
     y0, x0 = y.astype(int), x.astype(int)
     fy, fx = y - y0, x - x0
     fy, fx = fy * fy * (3 - 2 * fy), fx * fx * (3 - 2 * fx)
@@ -1043,7 +1046,14 @@ def _bumped(normal: np.ndarray, height: np.ndarray, slope: float) -> np.ndarray:
     return np.clip((n + 1) * 127.5, 0, 255).astype(np.uint8)
 
 
-def _grained(m: Material, span: tuple[float, float], size: int) -> None:
+# How much taller than wide a grain cell is in each row's texels, so that it is round on
+# the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
+# (~0.25 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm).
+# Square in texels, the pebble was streaked round the quarters and along the cap.
+GRAIN_STRETCH = {"upper": 2.4, "cap": 0.4}
+
+
+def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
     """Leather grain in one atlas row, in place: a fine pebble in the normal map (cells of
     ~1/300 of the texture), rougher in its valleys, and the gloss varying in soft patches
     (the leather was a plain, uniform gloss)."""
@@ -1053,8 +1063,10 @@ def _grained(m: Material, span: tuple[float, float], size: int) -> None:
     rng = np.random.default_rng(8)
     shape = (normal[rows].shape[0], normal[rows].shape[1])
     cell = max(2, size // 420)
-    pebble = np.abs(_smooth_noise(rng, shape, cell)) + 0.5 * np.abs(
-        _smooth_noise(rng, shape, 2 * cell))
+    if stretch < 1:  # cells narrower down the rows than across: wider across instead
+        cell = int(round(cell / stretch))
+    pebble = np.abs(_smooth_noise(rng, shape, cell, stretch)) + 0.5 * np.abs(
+        _smooth_noise(rng, shape, 2 * cell, stretch))
     height = -pebble  # pores and pebble valleys between raised grains
     normal[rows] = _bumped(normal[rows], height, GRAIN)
     patches = _smooth_noise(rng, shape, max(8, size // 24))
