@@ -36,6 +36,12 @@ SETS = {
 for _body, _names in SETS["avatar"]:
     SETS[f"one-{_names[-1]}"] = [(_body, _names)]
     SETS[f"mh-{_names[-1]}"] = SETS["makehuman"][SETS["avatar"].index((_body, _names)):][:1]
+# The eighth look pass: a man in shoes, a woman in boots, a child in sneakers.
+SETS["s8"] = [({"gender": 1.0, "age": 0.5}, ("socks", "shoes")),
+              ({"gender": 0.0, "age": 0.45}, ("boots",)),
+              ({"gender": 0.3, "age": 0.12}, ("sneakers",))]  # fmt: skip
+for _body, _names in SETS["s8"]:
+    SETS[f"s8-{_names[-1]}"] = [(_body, _names)]
 FRAMING = {name: (0.42 if len(s) > 1 else 0.6, 0.6, 0.06) for name, s in SETS.items()}
 VIEWS = {"profile": (0.6, -1.0, 0.12), "side": (1.0, 0.0, 0.08)}
 

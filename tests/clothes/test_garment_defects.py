@@ -236,12 +236,15 @@ def test_socks_stay_inside_the_shoe(params):
     from avatar.geometry import collision
 
     body = library.authoring_body()
-    upper_count = len(shoes.upper(body, shoes.Foot(body, 0)).mesh.vertices)
+    foot = shoes.Foot(body, 0)
+    # The upper as worn (without its faces under the toe cap) and the cap: the sock's cover.
+    worn_upper = shoes.capped(body, foot, shoes.upper(body, foot))
+    upper_count = sum(len(p.mesh.vertices) for p in worn_upper)
     human = Human(params).dressed("socks", "shoes")
     worn = {g.name: g for g in human.outfit.garments}
     shoe, sock = worn["shoes"], worn["socks"]
     faces = shoe.garment.mesh.faces
-    upper = faces[np.all(faces < upper_count, axis=1)]  # the left upper comes first
+    upper = faces[np.all(faces < upper_count, axis=1)]  # the left upper and cap come first
     v = shoe.mesh.vertices[:upper_count].astype(np.float64)
     outer = sock.mesh.vertices[len(sock.garment.mesh.vertices):].astype(np.float64)
     ground = human.vertices[:13380, 2].min()

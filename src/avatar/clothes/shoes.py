@@ -1,25 +1,32 @@
 """Shoes built from the foot: a leather upper, a rubber sole with a heel block, a toe cap
-and laces, all generated on the authoring body and bound to it, so they fit every foot.
+and laces, all generated on the authoring body and bound to it, so they fit every foot
+(their offsets scaled by the foot's size, ``_scaled_by_the_foot``).
 
 Parts, per foot (``x > 0`` is the body's left):
 
 - upper: the ``helper-tights`` faces of the foot and ankle, eased off the skin, its
-  opening smoothed into a curve, split finer and moved onto a last (``_Last``): the
-  foot's outline in plan with upright walls (a vertical heel counter, straight sides
-  down to the sole), rolling over onto a vamp that runs straight down to an almond toe
-  box past the toes; the bottom edge drawn down to just above the ground;
-- sole: a thin edge (``_sole_edge``) round the upper's bottom edge, out by a welt, down to
-  a tread a little below the foot, taller at the heel (a heel block), lifted under the
-  arch and curling up at the toe (toe spring), closed underneath;
+  opening smoothed into a curve, split finer (where the last shapes it) and moved onto a
+  last (``_Last``): the foot's outline in plan with upright walls (a vertical heel
+  counter, straight sides down to the sole), rolling over onto a vamp that runs straight
+  down over the toes and on, steepening, to a low almond toe box; the bottom edge drawn
+  down to just above the ground. A boot's shaft above the last is laid close round the
+  ankle and leg, flaring at its collar (``_shaft``). As worn (``capped``) it has no faces
+  under the toe cap, and its throat ends just over the top eyelets;
+- sole: an outsole round the upper's bottom edge (resampled to SOLE_POINTS), a thin welt
+  out, its wall bellied and bevelled in under the tread (``_sole_edge``), a little below
+  the foot, taller at the heel (a heel block with a breast: the waist lifted under the
+  arch), curling up at the toe (toe spring), closed underneath;
 - toe cap: the front of the upper again, on the same last 1.2 mm out, its back edge
-  (the seam over the vamp) smoothed into a curve and double-stitched;
-- lacing (``lacing``): a tongue under the laces, two quarters' facings either side of it
-  with eyelets, and one lace criss-crossing from eyelet to eyelet (each crossing over the
-  one before), tied in a bow at the top;
+  (the seam over the vamp) smoothed into a curve, skived down onto the vamp
+  (``_skived``) and double-stitched;
+- lacing (``lacing``): a tongue lying on the instep under the laces, two quarters'
+  facings either side of it with eyelets, and one lace criss-crossing from eyelet to
+  eyelet (each crossing over the one before), tied in a bow at the top;
 - a sneaker (``SNEAKER``) on a deep rubber midsole wrapping up over the toe (a toe
   bumper), with a band moulded round it, and a heel tab.
 
-They share one material: an atlas (``look``) whose rows hold leather, trim (eyelets, a
+They share one material: an atlas (``look``) whose rows hold leather (grained:
+``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), trim (eyelets, a
 sneaker's facings and heel tab), toe-cap leather, sole and lace cord, each piece's UVs
 laid out inside its row; the toe cap's and sole's UVs run from their seams, so stitching
 drawn across the atlas follows the cap's edge and the welt.
@@ -46,8 +53,9 @@ EASE = 0.005  # m between foot and upper (less let toes and socks through mid-st
 UNDER = 0.006
 COVER = 0.002
 HEEL = 0.014
-WELT = 0.003
-ARCH = 0.006  # m the tread is lifted between heel block and ball of the foot
+WELT = 0.0012  # a thin welt, the edge flush-ish with the upper (3 mm read as a ledge)
+BULGE = 0.0015  # m at most the sole follows the upper's bulge out (more read as a ledge)
+ARCH = 0.008  # m the tread is lifted between heel block and ball of the foot
 SPRING = 0.012  # m the tread curls up at the tip of the toe box (toe spring)
 CAP_EASE = EASE + 0.0012  # a toe cap sewn flat on the vamp, not a shell over it
 # The upper's faces end OPEN_BOTTOM m above the foot's lowest point, then its bottom
@@ -84,7 +92,7 @@ SHOE = Style()
 # ~2.3 cm tall at the ball, against a leather shoe's ~1 cm), 2 cm at the heel, wrapping
 # a centimetre further up round the toe (the toe bumper); contrasting facings, heel tab.
 # (15 mm rising 11 mm read as an orthopaedic platform.)
-SNEAKER = Style(under=0.012, cover=0.007, heel=0.02, welt=0.003, bumper=0.01,
+SNEAKER = Style(under=0.012, cover=0.007, heel=0.02, welt=0.002, bumper=0.01,
                 heel_tab=True, facings="trim")  # fmt: skip
 
 
@@ -134,7 +142,34 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     faces = body.group_faces("helper-tights")
     mesh = cut(body, faces, _shoe_faces(body, foot, faces, top), EASE, relax=10)
     mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, EASE))
+    if top <= LOW:
+        mesh = _shaft(body, foot, mesh)
     return bound(body, _planar_uvs(mesh, "upper"), faces)
+
+
+# A boot's shaft above the last: SHAFT_EASE m off the skin round the ankle and up the leg,
+# flaring out COLLAR m more over its top COLLAR_DEPTH m (a padded collar). Cut from the
+# tights shell it stood a straight tube 10-13 mm off the leg all the way up.
+SHAFT_EASE = 0.0065
+COLLAR = 0.004
+COLLAR_DEPTH = 0.025
+
+
+def _shaft(body: AuthoringBody, foot: Foot, mesh: Mesh) -> Mesh:
+    """The upper with its shaft (above the last, ``SHAPED_TO``) laid SHAFT_EASE off the
+    leg along the skin's normals, its collar flared."""
+    v = mesh.vertices.astype(np.float64)
+    z = v[:, 2] - foot.ground
+    w = np.clip((z - SHAPED_TO[0]) / (SHAPED_TO[1] - SHAPED_TO[0]), 0, 1)
+    w = w * w * (3 - 2 * w)
+    flare = np.clip((z - (z.max() - COLLAR_DEPTH)) / COLLAR_DEPTH, 0, 1)
+    target = SHAFT_EASE + COLLAR * flare * flare * (3 - 2 * flare)
+    for _ in range(2):  # twice: the nearest skin vertex changes as the shaft moves in
+        _, i = body.skin_tree.query(v)
+        normal = body.skin_normals[i].astype(np.float64)
+        gap = np.einsum("nd,nd->n", v - body.vertices[i], normal)
+        v -= (w * (gap - target))[:, None] * normal
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float,
@@ -143,18 +178,22 @@ def _toe_box(body: AuthoringBody, foot: Foot, mesh: Mesh, ease: float,
     the last (``_Last``), still ``ease`` off the skin; ``smooth_rim``: passes smoothing
     the cut (its boundary along itself, the rest after it) before it goes on the last
     again, so a seam runs in a curve, not in whole faces' steps."""
-    mesh = _subdivided(mesh)
+    # Split finer only where the last shapes it (a boot's shaft above stays as cut).
+    low = mesh.vertices[mesh.faces, 2].min(axis=1) < foot.ground + SHAPED_TO[1]
+    mesh = _subdivided(mesh, low)
     last = _Last(body, foot, ease)
     points = last.shape(mesh.vertices.astype(np.float64))
     if smooth_rim:
         points = last.shape(_smoothed(mesh.faces, points, smooth_rim))
-    # Out to ``ease`` along the nearest skin vertex's normal where the last cuts into the
-    # foot (a few vertices at the ankle): the worst of eight neighbours (``_at_least``)
-    # pushed a third of the shell out up to 16 mm, lumps all over the leather.
+    # Out to ``ease`` (less over the toes, as the last) along the nearest skin vertex's
+    # normal where the last cuts into the foot (a few vertices at the ankle): the worst of
+    # eight neighbours (``_at_least``) pushed a third of the shell out up to 16 mm, lumps
+    # all over the leather.
     _, i = body.skin_tree.query(points)
     normal = body.skin_normals[i].astype(np.float64)
     gap = np.einsum("nd,nd->n", points - body.vertices[i], normal)
-    points += np.clip(ease - gap, 0, None)[:, None] * normal
+    need = np.interp(foot.along(points), last.t, last.over) + (ease - last.ease)
+    points += np.clip(need - gap, 0, None)[:, None] * normal
     return Mesh(points.astype(np.float32), mesh.faces)
 
 
@@ -182,7 +221,33 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     # down to the sole at the sides and was dragged into spikes.
     mesh = _toe_box(body, foot, mesh, CAP_EASE, smooth_rim=6)
     mesh = _drawn_down(body, foot, mesh, reach=OPEN_BOTTOM)
-    return bound(body, _cap_uvs(mesh, foot), faces)
+    return bound(body, _cap_uvs(_skived(mesh, foot), foot), faces)
+
+
+SKIVE = 0.008  # m from the toe cap's seam over which its edge is thinned down to the vamp
+SEAM_STEP = 0.0003  # m the cap's edge stands over the vamp at its seam
+
+
+def _skived(mesh: Mesh, foot: Foot) -> Mesh:
+    """The toe cap with its seam edge sunk onto the vamp (to SEAM_STEP over it) over the
+    last SKIVE m, as a skived, stitched edge: standing CAP_EASE - EASE proud all the way
+    to the seam, its edge caught the light as a pale lip."""
+    from scipy.spatial import cKDTree
+
+    from avatar.geometry.shell import boundary_edges
+    from avatar.mesh import vertex_normals
+
+    v = mesh.vertices.astype(np.float64)
+    rim = np.unique(boundary_edges(mesh.faces)[0])
+    seam = rim[v[rim, 2] > foot.ground + OPEN_BOTTOM + 0.004]
+    d, _ = cKDTree(v[seam]).query(v)
+    w = np.clip(1 - d / SKIVE, 0, 1)
+    w = w * w * (3 - 2 * w)
+    normal = vertex_normals(mesh.vertices, mesh.faces).astype(np.float64)
+    centre = v.mean(axis=0) + [0, 0, -0.02]
+    normal *= np.sign(np.einsum("nd,nd->n", normal, v - centre))[:, None]  # outwards
+    v -= ((CAP_EASE - EASE - SEAM_STEP) * w)[:, None] * normal
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
 
 
 CAP_UV_REACH = 0.1  # m from the toe cap's seam that its row's height spans
@@ -228,7 +293,7 @@ def _at_least(body: AuthoringBody, points: np.ndarray, gap: float) -> np.ndarray
 def sole(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> Piece:
     """The sole under an upper: its lowest boundary loop extruded out and down, capped."""
     loop = _lowest_loop(top.mesh)
-    ring = top.mesh.vertices[loop].astype(np.float64)
+    ring = _resampled(top.mesh.vertices[loop].astype(np.float64), SOLE_POINTS)
     centre = ring.mean(axis=0)
     out = ring[:, :2] - centre[:2]
     out /= np.linalg.norm(out, axis=1, keepdims=True)
@@ -244,17 +309,21 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> Pi
     # ring (widening it over the neighbours first lifted a settled pose off its soles).
     for _ in range(3):
         extra = 0.5 * extra + 0.25 * (np.roll(extra, 1) + np.roll(extra, -1))
+    extra = np.minimum(extra, BULGE)
     ring = ring.copy()
     ring[:, :2] += extra[:, None] * out
     t = foot.along(ring)
     edge, tread = _sole_edge(ring, t, foot, style)
     welt = style.welt
+    # The edge's profile: in from the welt's lip, out to a belly a third of the way down,
+    # bevelled in under the tread: a rounded outsole (it was a flat plate with a ledge).
+    belly = edge - (edge - tread) / 3
     rings = [
         np.column_stack([ring[:, :2] - 0.001 * out - extra[:, None] * out,
                          edge + 0.001]),  # tucked under the upper's edge
-        np.column_stack([ring[:, :2] + welt * out, edge]),  # welt top
-        np.column_stack([ring[:, :2] + welt * out, tread + 0.002]),
-        np.column_stack([ring[:, :2] + (welt - 0.0015) * out, tread]),  # the edge rounded
+        np.column_stack([ring[:, :2] + 0.5 * welt * out, edge]),  # welt top
+        np.column_stack([ring[:, :2] + welt * out, belly]),
+        np.column_stack([ring[:, :2] + (welt - 0.002) * out, tread]),  # the edge bevelled
     ]
     n = len(ring)
     # The tread's middle, under the arch: lifted as the arch's edge is, by half.
@@ -266,7 +335,11 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> Pi
             j = (i + 1) % n
             faces.append([a + i, a + j, b + j, b + i])
     middle, bottom = len(points) - 1, (len(rings) - 1) * n
-    faces += [[bottom + (i + 1) % n, bottom + i, middle, middle] for i in range(n)]
+    # The tread (never seen from above): quads of two ring edges each to the middle.
+    faces += [[bottom + (i + 2) % n, bottom + (i + 1) % n, bottom + i, middle]
+              for i in range(0, n - n % 2, 2)]
+    if n % 2:
+        faces.append([bottom, bottom + n - 1, middle, middle])
     mesh = Mesh(points.astype(np.float32), np.array(faces, np.int32))
     mesh = _facing_out(mesh, centre + [0, 0, 0.02])
     mesh = _planar_uvs(mesh, "sole")
@@ -280,9 +353,21 @@ def sole(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> Pi
     return bound(body, mesh, body.group_faces("helper-tights"))
 
 
+SOLE_POINTS = 44  # round the sole (the upper's bottom edge has ~60: a 30% lighter sole)
+
+
+def _resampled(ring: np.ndarray, n: int) -> np.ndarray:
+    """(n, 3) points evenly along a closed polyline (M, 3)."""
+    closed = np.concatenate([ring, ring[:1]])
+    length = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    s = np.linspace(0, length[-1], n, endpoint=False)
+    return np.column_stack([np.interp(s, length, closed[:, k]) for k in range(3)])
+
+
 # The sole's rings' places in its atlas row (0 the tread's middle, 1 the edge tucked under
-# the upper): the welt's top lip spans 0.9-1, the wall 0.1-0.9.
-SOLE_RINGS = (1.0, 0.9, 0.1, 0.05)
+# the upper): the welt's top lip spans 0.9-1, the wall 0.1-0.9 (its belly, a third of the
+# way down, at 0.63).
+SOLE_RINGS = (1.0, 0.9, 0.63, 0.1)
 
 
 def sole_v(place: float) -> float:
@@ -306,7 +391,10 @@ def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot,
     top = np.maximum(top, foot.ground + style.heel * heel)
     toe = np.clip((t - 0.82) / 0.12, 0, 1)
     top = top + style.bumper * toe * toe * (3 - 2 * toe)  # a sneaker's toe bumper
-    arch = ARCH * np.clip(1 - np.abs(t - 0.45) / 0.15, 0, 1) ** 0.5
+    # The waist lifted off the ground from the heel's breast (a step, so the heel reads as
+    # a heel) to the ball, easing down into it.
+    rise, fall = np.clip((t - 0.27) / 0.04, 0, 1), np.clip((0.66 - t) / 0.12, 0, 1)
+    arch = ARCH * np.minimum(rise, fall * fall * (3 - 2 * fall))
     spring = SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
     tread = foot.ground - style.under + arch + spring
     return top, np.minimum(tread, top - 0.004)
@@ -319,6 +407,9 @@ def _sole_edge(ring: np.ndarray, t: np.ndarray, foot: Foot,
 # under it sank into it in patches (navy facings as blotches on a sneaker).
 TONGUE_LIFT, FACING_LIFT, EYELET_LIFT, LACE_LIFT = 0.001, 0.002, 0.0026, 0.0032
 LACE_WIDTH = 0.0035
+SKIVED_END = 0.0003  # m a tongue's or facing's front end stands over the upper
+TONGUE_OVER = 0.003  # m the tongue's top stands over the top eyelets
+BOW_OVER = 0.005  # m the bow's loops reach over the top eyelets (flopped on the instep)
 LACE_ROWS = (0.72, 0.47)  # along the foot: the lowest eyelets (towards the toes), the top
 
 
@@ -403,23 +494,30 @@ def _lacing(foot: Foot, top: Piece, rows: int = LACES) -> Lacing:
 
 
 def _ribbon(points: np.ndarray, normals: np.ndarray, width: float, crown: float) -> Mesh:
-    """A strip along a polyline (M, 3) lying on a surface of ``normals`` (M, 3): three
-    vertices across (edges and a crown ``crown`` m higher), so it shades as a cord."""
+    """A strip along a polyline (M, 3) lying on a surface of ``normals`` (M, 3): two
+    vertices across, its edges ``crown`` m lower than its middle line (the garment's
+    thickness makes it a cord; a third vertex across for a crown cost 40% of a pair's
+    triangles in laces)."""
     tangent = np.gradient(points, axis=0)
     tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-12)
     side = np.cross(normals, tangent)
     side /= np.maximum(np.linalg.norm(side, axis=1, keepdims=True), 1e-12)
-    across = [points - side * width / 2, points + normals * crown, points + side * width / 2]
+    across = [points - side * width / 2 + normals * crown / 2,
+              points + side * width / 2 + normals * crown / 2]
     n = len(points)
-    faces = [[j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i]
-             for j in range(2) for i in range(n - 1)]  # fmt: skip
+    faces = [[i, i + 1, n + i + 1, n + i] for i in range(n - 1)]
     return Mesh(np.concatenate(across).astype(np.float32), np.array(faces, np.int32))
 
 
 def _sheet(surface: _Surface, xy: np.ndarray, lift: float) -> Mesh | None:
-    """A grid (R, C, 2) of xy laid ``lift`` m over the upper (rows missing it dropped)."""
+    """A grid (R, C, 2) of xy laid ``lift`` m over the upper (rows missing it dropped),
+    its first row (the front end, towards the toes) sunk to SKIVED_END over it: a step
+    the leather's thickness over the vamp caught the light as a pale lip."""
     r, c = xy.shape[:2]
-    points, _, found = surface.over(xy.reshape(-1, 2), lift)
+    points, normal, found = surface.over(xy.reshape(-1, 2), 0.0)
+    rows = np.full(r, lift)
+    rows[0] = min(lift, SKIVED_END)
+    points = points + np.repeat(rows, c)[:, None] * normal
     keep = found.reshape(r, c).all(axis=1)
     if keep.sum() < 2:
         return None
@@ -436,13 +534,18 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
     surface = _Surface(top.mesh)
     plan = _lacing(foot, top)
     faces = body.group_faces("helper-tights")
-    along = np.linspace(plan.y[0] - 0.012, plan.y[-1] + 0.006, 9)  # toes to throat
+    along = np.linspace(plan.y[0] - 0.012, plan.y[-1] + 0.004, 7)  # toes to throat
     x = np.interp(along, plan.y[::-1], plan.x[::-1])
     half = np.interp(along, plan.y[::-1], plan.half[::-1])
     tongue = _sheet(surface, np.stack([np.column_stack([x + f * (half + 0.004), along])
-                                       for f in np.linspace(-1, 1, 5)], 1), TONGUE_LIFT)
+                                       for f in np.linspace(-1, 1, 4)], 1), TONGUE_LIFT)
     pieces = []
     if tongue is not None:
+        # Lying on the instep, its top TONGUE_OVER over the top eyelets: laid over the
+        # steep throat it stood up as a flap above the laces.
+        v = tongue.vertices.copy()
+        v[:, 2] = np.minimum(v[:, 2], _top_eyelets_z(surface, plan) + TONGUE_OVER)
+        tongue = Mesh(v, tongue.faces)
         pieces.append(bound(body, _planar_uvs(tongue, "upper"), faces))
     facings = []
     for side in (-1, 1):
@@ -459,12 +562,18 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
     return pieces
 
 
-def _disc(surface: _Surface, xy: np.ndarray, radius: float, sides: int = 6) -> Mesh:
-    """An eyelet: a disc ``radius`` m round xy lying EYELET_LIFT over the upper."""
-    angle = np.linspace(0, 2 * np.pi, sides, endpoint=False)
+def _top_eyelets_z(surface: _Surface, plan: Lacing) -> float:
+    """z (m) of the higher of the top pair of eyelets."""
+    ends = np.concatenate([plan.eyelets(-1)[-1:], plan.eyelets(1)[-1:]])
+    return float(surface.over(ends, EYELET_LIFT)[0][:, 2].max())
+
+
+def _disc(surface: _Surface, xy: np.ndarray, radius: float) -> Mesh:
+    """An eyelet: a hexagon ``radius`` m round xy lying EYELET_LIFT over the upper."""
+    angle = np.linspace(0, 2 * np.pi, 6, endpoint=False)
     ring = xy + radius * np.column_stack([np.cos(angle), np.sin(angle)])
-    points, _, _ = surface.over(np.concatenate([[xy], ring]), EYELET_LIFT)
-    faces = [[0, 1 + i, 1 + (i + 1) % sides, 0] for i in range(sides)]
+    points, _, _ = surface.over(ring, EYELET_LIFT)
+    faces = [[0, 1, 2, 3], [0, 3, 4, 5]]  # two quads, not a fan of six: a third the triangles
     return Mesh(points.astype(np.float32), np.array(faces, np.int32))
 
 
@@ -481,14 +590,14 @@ def lace(surface: _Surface, plan: Lacing) -> Mesh:
     knot = np.array([plan.x[-1], plan.y[-1] + 0.004])
     path, lift = [], []
 
-    def run(a, b, rise: float, steps: int = 5) -> None:
+    def run(a, b, rise: float, steps: int = 2) -> None:  # a vertex where the ends cross
         s = np.linspace(0, 1, steps, endpoint=False)
         path.extend(a + s[:, None] * (b - a))
         lift.extend(LACE_LIFT + rise * np.sin(np.pi * s))
 
     bow = _bow(knot, plan.half[-1])
     for a, b in zip(bow[0][:-1], bow[0][1:], strict=True):  # tail, loops, back to the knot
-        run(a, b, 0.0015, 2)
+        run(a, b, 0.0015, 1)
     run(knot, up_a[-1], 0.0008, 3)
     for a, b in zip(up_a[::-1][:-1], up_a[::-1][1:], strict=True):  # down one end
         run(a, b, 0.0003)
@@ -497,7 +606,7 @@ def lace(surface: _Surface, plan: Lacing) -> Mesh:
         run(a, b, 0.0012)
     run(up_b[-1], knot, 0.0008, 3)
     for a, b in zip(bow[1][:-1], bow[1][1:], strict=True):
-        run(a, b, 0.0015, 2)
+        run(a, b, 0.0015, 1)
     path.append(bow[1][-1])
     lift.append(LACE_LIFT)
     xy = np.asarray(path)
@@ -507,20 +616,21 @@ def lace(surface: _Surface, plan: Lacing) -> Mesh:
     points[~found, 2] = np.interp(index[~found], index[found], points[found, 2])
     normal[~found] = (0.0, 0.0, 1.0)
     points = points + np.asarray(lift)[:, None] * normal
+    points[:, 2] = np.minimum(points[:, 2], _top_eyelets_z(surface, plan) + BOW_OVER)
     return _ribbon(points, normal, LACE_WIDTH, 0.0007)
 
 
 def _bow(knot: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
     """(first, second) xy polylines of a bow: the first from one tail's end to the knot and
     round its loop back to it, the second round the other loop and out to the other tail."""
-    phi = np.linspace(0, 2 * np.pi, 10)
+    phi = np.linspace(0, 2 * np.pi, 8)
 
     def loop(side: int) -> np.ndarray:
         return knot + np.column_stack([side * (half + 0.012) * (1 - np.cos(phi)) / 2,
                                        0.009 * side * np.sin(phi)])  # fmt: skip
 
     def tail(side: int) -> np.ndarray:  # from the knot out to its end
-        return knot + np.linspace(0, 1, 4)[:, None] * [side * 0.008, -0.03]
+        return knot + np.linspace(0, 1, 3)[:, None] * [side * 0.008, -0.03]
 
     return np.concatenate([tail(-1)[::-1], loop(-1)[1:]]), np.concatenate([loop(1), tail(1)[1:]])
 
@@ -564,11 +674,56 @@ def shoes(body: AuthoringBody, top: float = 0.96, style: Style = SHOE) -> Piece:
     for side in (0, 1):
         foot = Foot(body, side)
         top_piece = upper(body, foot, top)
-        pieces += [top_piece, toe_cap(body, foot), sole(body, foot, top_piece, style),
-                   *lacing(body, foot, top_piece, style)]
+        pieces += [*capped(body, foot, top_piece), sole(body, foot, top_piece, style),
+                   *lacing(body, foot, top_piece, style)]  # fmt: skip
         if style.heel_tab:
             pieces.append(heel_tab(body, foot, top_piece))
-    return join(pieces)
+    return _scaled_by_the_foot(body, join(pieces))
+
+
+def _scaled_by_the_foot(body: AuthoringBody, piece: Piece) -> Piece:
+    """The shoes with their offsets scaled by the foot (its width, length and height), not
+    by the head (``bound``'s pairs, MakeHuman's default): a child's head is large for its
+    feet, so a child's soles, welts and toe boxes came out a third too thick."""
+    from avatar.clothes.binding import make_binding
+
+    skin = body.vertices[: len(body.part)]
+    foot = np.flatnonzero((body.part == "foot") & (skin[:, 0] > 0))
+    p = skin[foot]
+    refs = np.array([[foot[np.argmin(p[:, k])], foot[np.argmax(p[:, k])]] for k in range(3)])
+    lengths = np.ptp(p, axis=0).astype(np.float64)
+    b = piece.binding
+    binding = make_binding(b.indices, b.weights, b.offsets, refs, lengths, b.single)
+    return Piece(piece.mesh, binding, piece.layout)
+
+
+CAP_OVERLAP = 0.012  # m the upper runs on under the toe cap past its seam
+THROAT_OVER = 0.003  # m over the top eyelets where the upper's throat ends
+
+
+def capped(body: AuthoringBody, foot: Foot, top: Piece) -> tuple[Piece, Piece]:
+    """(the upper as worn, its toe cap): the upper without its faces hidden under the cap
+    (all corners within 4 mm of it and CAP_OVERLAP past its seam: never seen, they were
+    a tenth of a pair's triangles) and its throat cut down to THROAT_OVER over the top
+    eyelets."""
+    from scipy.spatial import cKDTree
+
+    from avatar.geometry.shell import boundary_edges
+
+    cap = toe_cap(body, foot)
+    c = cap.mesh.vertices.astype(np.float64)
+    rim = np.unique(boundary_edges(cap.mesh.faces)[0])
+    seam = rim[c[rim, 2] > foot.ground + OPEN_BOTTOM + 0.004]  # the seam over the vamp
+    v = top.mesh.vertices.astype(np.float64)
+    under = (cKDTree(c).query(v)[0] < 0.004) & (cKDTree(c[seam]).query(v)[0] > CAP_OVERLAP)
+    keep = ~under[top.mesh.faces].all(axis=1)
+    # The throat opens to just over the top eyelets: the upper ran on up the front of the
+    # ankle, a flap standing over the laces and the tongue.
+    corners = v[top.mesh.faces]
+    line = _top_eyelets_z(_Surface(top.mesh), _lacing(foot, top)) + THROAT_OVER
+    keep &= ~((foot.along(corners.mean(axis=1)) > 0.42) & (corners[..., 2].max(axis=1) > line))
+    seen = bound(body, top.mesh.subset(np.flatnonzero(keep)), body.group_faces("helper-tights"))
+    return seen, cap
 
 
 def sneakers(body: AuthoringBody) -> Piece:
@@ -585,9 +740,11 @@ def sneakers(body: AuthoringBody) -> Piece:
 # shell, the vamp domed, the toe a ball, the sides bulging over a pinched bottom edge.
 WALL = 0.011
 ROLL = 0.75
-TOE_BOX = 0.016  # m the toe box reaches past the toes
+TOE_BOX = 0.013  # m the toe box reaches past the toes
 TAPER = 0.3  # how much narrower the toe box's tip is than the toes' spread
-VAMP = (0.66, 0.98)  # along the foot: the vamp's straight run, from the throat to the toe
+TOE_EASE = 0.003  # m over the toes (the instep has EASE)
+TOE_TIP = 0.06  # the toe box's tip: this fraction of the foot's length over the ground
+VAMP = (0.66, 0.97)  # along the foot: the vamp's straight run, from the throat to the toe
 SHAPED_TO = (0.07, 0.1)  # m above the ground: shaped fully below, not at all above (a boot)
 
 
@@ -612,10 +769,12 @@ class _Last:
         points = skin[near & (body.part == "foot")]  # the leg's front is the throat's
         along = foot.along(points)
         top = np.full(len(self.t), np.nan)
+        # Less ease over the toes than over the instep: the toe box sits low on them.
+        over = ease - (ease - TOE_EASE) * np.clip((self.t - 0.8) / 0.1, 0, 1)
         for k, tk in enumerate(self.t):
             band = np.abs(along - tk) < 0.02
             if band.any():
-                top[k] = points[band, 2].max() + ease
+                top[k] = points[band, 2].max() + over[k]
         have = np.isfinite(top)
         top = np.interp(self.t, self.t[have], top[have])
         top[self.t > 1.0] = top[self.t <= 1.0][-1]
@@ -623,8 +782,17 @@ class _Last:
         ha = float(np.interp(a, self.t, top))
         toe = float(np.interp(b, self.t, top))  # over the toes' tips
         line = ha + (toe - ha) * (self.t - a) / (b - a)
-        line -= 2 * (ha - toe) * np.clip(self.t - b, 0, None) / (b - a)  # the toe's slope
         top = np.where(self.t >= a, np.maximum(line, np.where(self.t <= 1.0, top, -1)), top)
+        # Past the toes the vamp's line runs on down, steepening, to a low tip TOE_TIP x
+        # the foot's length over the ground (it ran on at twice the vamp's slope from
+        # higher over the toes: a tall, square front).
+        reach = 1.0 + TOE_BOX / (foot.heel_y - foot.toe_y)
+        tip = foot.ground + TOE_TIP * (foot.heel_y - foot.toe_y)
+        u = np.clip((self.t - b) / (reach - b), 0, 1)
+        slope = (ha - toe) / (b - a)
+        nose = toe - slope * (self.t - b) * (1 + 1.5 * u)
+        top = np.where(self.t > b, np.maximum(np.minimum(top, nose), tip), top)
+        self.over = over
         # Behind the throat the counter and quarters stand up to the topline, no top.
         self.top = np.maximum(top, 0.3 * np.clip((0.4 - self.t) / 0.1, 0, 1))
         self.half = np.array([_half_width(self.outline, yk) for yk in y])
@@ -751,21 +919,43 @@ def _smoothed(faces: np.ndarray, points: np.ndarray, passes: int) -> np.ndarray:
     return p
 
 
-def _subdivided(mesh: Mesh) -> Mesh:
-    """Each quad split in four (edge midpoints, face centre): room for the last's edges."""
+def _subdivided(mesh: Mesh, refine: np.ndarray | None = None) -> Mesh:
+    """Quads split in four (edge midpoints, face centre): room for the last's edges.
+    ``refine`` (F,) bool: only these (None: all), grown until no other face has two split
+    edges; a face with one split edge becomes a quad and a triangle (no T-junctions)."""
     v = mesh.vertices.astype(np.float64)
     f = mesh.faces
     edges = np.sort(np.stack([f, np.roll(f, -1, axis=1)], -1).reshape(-1, 2), axis=1)
     unique, inverse = np.unique(edges, axis=0, return_inverse=True)
     inverse = inverse.reshape(f.shape)
-    mids = v[unique].mean(axis=1)
-    centres = v[f].mean(axis=1)
-    e0, c0 = len(v), len(v) + len(unique)
+    refine = np.ones(len(f), bool) if refine is None else refine.copy()
+    while True:
+        split = np.zeros(len(unique), bool)
+        split[inverse[refine].ravel()] = True
+        grow = ~refine & (split[inverse].sum(axis=1) >= 2)
+        if not grow.any():
+            break
+        refine |= grow
+    edge_vertex = np.cumsum(split) - 1 + len(v)  # the new vertex of each split edge
+    mids = v[unique[split]].mean(axis=1)
+    fine = np.flatnonzero(refine)
+    c0 = len(v) + len(mids)
     faces = []
     for k in range(4):  # corner k, the edge after it, the centre, the edge before it
-        faces.append(np.stack([f[:, k], e0 + inverse[:, k], c0 + np.arange(len(f)),
-                               e0 + inverse[:, (k - 1) % 4]], 1))  # fmt: skip
-    points = np.concatenate([v, mids, centres]).astype(np.float32)
+        faces.append(np.stack([f[fine, k], edge_vertex[inverse[fine, k]],
+                               c0 + np.arange(len(fine)),
+                               edge_vertex[inverse[fine, (k - 1) % 4]]], 1))  # fmt: skip
+    coarse = np.flatnonzero(~refine)
+    cut_edge = split[inverse[coarse]]  # (C, 4) at most one per face
+    faces.append(f[coarse[~cut_edge.any(axis=1)]])
+    for k in range(4):  # corner k, its split edge's middle m, then the others: quad + triangle
+        one = coarse[cut_edge[:, k]]
+        if len(one):
+            m = edge_vertex[inverse[one, k]]
+            c = [f[one, (k + j) % 4] for j in range(4)]
+            faces.append(np.stack([c[0], m, c[2], c[3]], 1))
+            faces.append(np.stack([m, c[1], c[2], c[2]], 1))
+    points = np.concatenate([v, mids, v[f[fine]].mean(axis=1)]).astype(np.float32)
     return Mesh(points, np.concatenate(faces).astype(np.int32))
 
 
@@ -804,6 +994,11 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
         ], size, stitches=tuple(stitches))  # fmt: skip
         if band is not None:
             _moulded_band(m, fabrics.rgb(band), size)
+        for row in ("upper", "cap"):
+            if upper in LEATHERS:
+                _grained(m, ROWS[row], size, GRAIN_STRETCH[row])
+            else:
+                _knit_mesh(m, ROWS[row], size)
         return m
 
     return material
@@ -814,6 +1009,86 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
 UPPER_STITCH_V = ROWS["upper"][0] + (ROWS["upper"][1] - ROWS["upper"][0]) * (0.05 + 0.9 * 0.1)
 MIDSOLE_STRIPE = (0.62, 0.78)  # the band's span up the midsole's wall (``sole_v`` places)
 MIDSOLE_GROOVE = 0.45
+
+
+LEATHERS = ("calf", "leather", "suede")
+GRAIN = 0.5  # the pebble's slope in the normal map (tangent units per texel of height)
+
+
+def _rows(span: tuple[float, float], size: int) -> slice:
+    return slice(int(round((1 - span[1]) * size)), int(round((1 - span[0]) * size)))
+
+
+def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], cell: int,
+                  stretch: float = 1.0) -> np.ndarray:  # fmt: skip
+    """(H, W) noise in [-1, 1]: random values every ``cell`` texels across (``stretch`` x
+    ``cell`` down the rows), smoothly interpolated."""
+    h, w = shape
+    down = cell * stretch
+    coarse = rng.uniform(-1, 1, (int(h // down) + 2, w // cell + 2))
+    y, x = np.arange(h) / down, np.arange(w) / cell
+    y0, x0 = y.astype(int), x.astype(int)
+    fy, fx = y - y0, x - x0
+    fy, fx = fy * fy * (3 - 2 * fy), fx * fx * (3 - 2 * fx)
+    a, b = coarse[y0][:, x0], coarse[y0][:, x0 + 1]
+    c, d = coarse[y0 + 1][:, x0], coarse[y0 + 1][:, x0 + 1]
+    top = a + (b - a) * fx[None]
+    return top + (c + (d - c) * fx[None] - top) * fy[:, None]
+
+
+def _bumped(normal: np.ndarray, height: np.ndarray, slope: float) -> np.ndarray:
+    """(H, W, 3) uint8 tangent-space normals tilted by the gradient of ``height`` (H, W)."""
+    n = normal.astype(np.float32) / 127.5 - 1
+    gy, gx = np.gradient(height)
+    n[..., 0] -= slope * gx
+    n[..., 1] += slope * gy  # image rows run down the texture, v up
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    return np.clip((n + 1) * 127.5, 0, 255).astype(np.uint8)
+
+
+# How much taller than wide a grain cell is in each row's texels, so that it is round on
+# the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
+# (~0.25 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm).
+# Square in texels, the pebble was streaked round the quarters and along the cap.
+GRAIN_STRETCH = {"upper": 2.4, "cap": 0.4}
+
+
+def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
+    """Leather grain in one atlas row, in place: a fine pebble in the normal map (cells of
+    ~1/300 of the texture), rougher in its valleys, and the gloss varying in soft patches
+    (the leather was a plain, uniform gloss)."""
+    normal, rough = m.normal_texture, m.roughness_texture
+    assert normal is not None and rough is not None
+    rows = _rows(span, size)
+    rng = np.random.default_rng(8)
+    shape = (normal[rows].shape[0], normal[rows].shape[1])
+    cell = max(2, size // 420)
+    if stretch < 1:  # cells narrower down the rows than across: wider across instead
+        cell = int(round(cell / stretch))
+    pebble = np.abs(_smooth_noise(rng, shape, cell, stretch)) + 0.5 * np.abs(
+        _smooth_noise(rng, shape, 2 * cell, stretch))
+    height = -pebble  # pores and pebble valleys between raised grains
+    normal[rows] = _bumped(normal[rows], height, GRAIN)
+    patches = _smooth_noise(rng, shape, max(8, size // 24))
+    r = rough[rows].astype(np.float32) + 255 * (0.1 + 0.07 * patches + 0.08 * pebble)
+    rough[rows] = np.clip(r, 0, 255).astype(np.uint8)
+
+
+def _knit_mesh(m: Material, span: tuple[float, float], size: int) -> None:
+    """A sneaker's textile upper in one atlas row, in place: an engineered mesh, open
+    cells in a diamond lattice, each a shade darker and sunk in the normal map."""
+    image, normal, rough = m.base_color_texture, m.normal_texture, m.roughness_texture
+    assert image is not None and normal is not None and rough is not None
+    rows = _rows(span, size)
+    h, w = image[rows].shape[:2]
+    pitch = max(4, size // 170)
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    a = (x + y) * np.pi / pitch
+    b = (x - y) * np.pi / pitch
+    cells = np.clip(np.sin(a) * np.sin(b), 0, None) ** 0.5  # 1 in a cell's middle, 0 on ribs
+    image[rows] = (image[rows].astype(np.float32) * (1 - 0.22 * cells[..., None])).astype(np.uint8)
+    normal[rows] = _bumped(normal[rows], -cells, 0.6)
+    rough[rows] = np.clip(rough[rows].astype(np.float32) + 30 * cells, 0, 255).astype(np.uint8)
 
 
 def _moulded_band(m: Material, colour: np.ndarray, size: int) -> None:
