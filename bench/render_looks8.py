@@ -5,6 +5,7 @@ and dress hems mid-stride, the hoodie under the arm and the open jacket's front,
     python bench/render_looks8.py hems --views front,back --walk --frame 6 --samples 12
     python bench/render_looks8.py armpit --views front,under
     python bench/render_looks8.py opening --views front,side
+    python bench/render_looks8.py necks --views front      # band edges: necks, armholes
 
 Needs the pip ``bpy`` module (Cycles on the CPU).
 """
@@ -29,9 +30,15 @@ SETS = {
         ({"gender": 1.0, "age": 0.5}, ("jacket", "tshirt", "jeans")),
         ({"gender": 0.0, "age": 0.45}, ("jacket", "longsleeve", "trousers")),
     ],
+    "necks": [  # band edges at the neck and armholes (lone band patches dropped)
+        ({"gender": 0.0, "age": 0.45}, ("longsleeve", "jeans")),
+        ({"gender": 1.0, "age": 0.5}, ("tshirt", "jeans")),
+        ({"gender": 0.0, "age": 0.3}, ("dress",)),
+        ({"gender": 0.0, "age": 0.6}, ("cardigan", "tshirt", "skirt")),
+    ],
 }  # fmt: skip
 FRAMING = {"hems": looks7.FRAMING["hems"], "armpit": (0.9, 0.6, 1.05),
-           "opening": (1.1, 0.8, 1.05)}  # fmt: skip
+           "opening": (1.1, 0.8, 1.05), "necks": (0.8, 0.8, 1.15)}  # fmt: skip
 
 # From the wearer's left, a little below the arm: the underarm (the hoodie's armpit).
 VIEWS = {"under": (1.0, -0.35, -0.3)}
