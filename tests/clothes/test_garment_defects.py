@@ -810,3 +810,46 @@ def test_cardigan_back_hem_runs_level_across_the_seat(params):
     faces = base.faces[base.face_groups["body"]]
     _, depth = collision.penetration(human.outfit.rest_body, faces, fitted.mesh.vertices)
     assert depth.max() < 0.001, depth.max()
+
+
+def _face_pairs(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(P,), (P,) the two faces of every edge two faces share."""
+    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(faces)), faces.shape[1])
+    order = np.lexsort(edges.T[::-1])
+    edges, owner = edges[order], owner[order]
+    shared = np.all(edges[1:] == edges[:-1], axis=1) & (edges[1:, 0] != edges[1:, 1])
+    return owner[:-1][shared], owner[1:][shared]
+
+
+@pytest.mark.parametrize("name", ["hoodie", "jacket"])
+def test_tops_do_not_fold_under_the_arm(name):
+    """Eased 1.3-2.5 cm out of the armpit's crease (a tighter curve than that), the cloth
+    crossed itself under the arm: neighbouring faces turned up to 180 degrees against each
+    other (24 such pairs on the hoodie), a dark triangle under the arm from the front and
+    the side. No two neighbouring faces under the arm now turn more than 100 degrees
+    against each other, on the built garment and on a body wearing it."""
+    from avatar.clothes import builtin, library
+    from avatar.clothes.authoring import AuthoringBody
+
+    body = library.authoring_body()
+    piece = builtin.BY_NAME[name].make(body)
+    human = Human(WOMAN).dressed(name)
+    fitted = human.outfit.garments[0]
+    count = len(fitted.garment.mesh.vertices)
+    for v, faces, marks in ((piece.mesh.vertices, piece.mesh.faces, body.marks),
+                            (fitted.mesh.vertices[:count], fitted.garment.mesh.faces,
+                             AuthoringBody(human.body).marks)):  # fmt: skip
+        v = v.astype(np.float64)
+        centre = v[faces].mean(axis=1)
+        shoulder = marks.shoulder[:, 2].mean()
+        # (not the hood's roll lying on the back behind it)
+        under = ((np.abs(centre[:, 0]) > 0.1) & (np.abs(centre[:, 0]) < 0.26)
+                 & (np.abs(centre[:, 1] - marks.shoulder[:, 1].mean()) < 0.06)
+                 & (centre[:, 2] > shoulder - 0.25) & (centre[:, 2] < shoulder))  # fmt: skip
+        q = v[faces]
+        n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+        a, b = _face_pairs(faces)
+        turn = np.einsum("nd,nd->n", n[a], n[b])
+        assert (turn[under[a]] > -0.17).all(), centre[a[under[a] & (turn < -0.17)]]

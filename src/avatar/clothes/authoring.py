@@ -103,11 +103,76 @@ def cut(
     if callable(ease):
         arm, leg = regions.limb_coordinates(points, body.marks)
         ease = ease(points, arm, leg)
-    moves = np.asarray(ease)[..., None] * normals
-    points = points + (on_their_side(points, moves) if sided else moves)
+    ease = np.broadcast_to(np.asarray(ease, dtype=np.float64), (len(points),))
+    points = _eased(points, local, normals, ease, sided)
     ridge = float(body.marks.shoulder[:, 1].mean())
     mesh = with_box_uvs(orient_outward(body, points.astype(np.float32), local), ridge_y=ridge)
     return with_limb_uvs(mesh, body.part[used], body.marks)
+
+
+# cos of the angle between two neighbouring faces below which cloth counts as folded back
+# on itself (``_eased``); the ease kept each round at the folds' vertices, and the rounds.
+FOLDED = -0.2
+FOLD_EASE = 0.75
+FOLD_ROUNDS = 12
+# m either side of the midplane where folds are left alone: the cleft of the buttocks folds
+# the eased cloth too, and ``builtin.bridged``/``spanned`` span it (less ease there left a
+# groove down the back).
+FOLD_MIDLINE = 0.05
+
+
+def _eased(points: np.ndarray, faces: np.ndarray, normals: np.ndarray, ease: np.ndarray,
+           sided: bool) -> np.ndarray:  # fmt: skip
+    """(N, 3) points moved ``ease`` (N,) m along ``normals`` (N, 3), less where that folds
+    the cloth: in a crease tighter than the ease (the armpit) the moved points cross over
+    and faces turn 180 degrees against their neighbours (a dark triangle under the
+    hoodie's and the jacket's arms). Each round, the folded faces' vertices and the ring
+    round them keep ``FOLD_EASE`` of their ease (smoothed over their neighbours, so the
+    cloth does not step), until no face folds."""
+    ease = ease.copy()
+    first, second = face_pairs(faces)
+    a = faces.reshape(-1)
+    b = np.roll(faces, -1, axis=1).reshape(-1)
+    real = a != b
+    a, b = np.concatenate([a[real], b[real]]), np.concatenate([b[real], a[real]])
+    degree = np.maximum(np.bincount(a, minlength=len(points)), 1)
+    for _ in range(FOLD_ROUNDS + 1):
+        moves = ease[:, None] * normals
+        out = points + (on_their_side(points, moves) if sided else moves)
+        n = face_normals(out, faces)
+        folded = np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
+        if not folded.any():
+            break
+        near = np.zeros(len(points), bool)
+        near[faces[np.concatenate([first[folded], second[folded]])].ravel()] = True
+        near[b[near[a]]] = True
+        near &= np.abs(points[:, 0]) > FOLD_MIDLINE
+        if not near.any():
+            break
+        ease[near] *= FOLD_EASE
+        for _ in range(2):  # no step between the eased and the kept cloth
+            mean = np.bincount(a, ease[b], minlength=len(points)) / degree
+            ease = np.minimum(ease, 0.5 * (ease + mean))
+    return out
+
+
+def face_pairs(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(P,), (P,) the two faces of every edge two faces (F, C) share."""
+    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(faces)), faces.shape[1])
+    real = edges[:, 0] != edges[:, 1]
+    edges, owner = edges[real], owner[real]
+    order = np.lexsort(edges.T[::-1])
+    edges, owner = edges[order], owner[order]
+    shared = np.all(edges[1:] == edges[:-1], axis=1)
+    return owner[:-1][shared], owner[1:][shared]
+
+
+def face_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F, 3) unit normals of quads or padded triangles (F, 4) (from the diagonals)."""
+    q = v[faces]
+    n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
+    return n / np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
 
 
 MIDPLANE = 1e-5  # m: a vertex this close to x = 0 lies on the body's plane of symmetry
@@ -471,7 +536,7 @@ def banded(mesh: Mesh, width=0.015, lift: float = 0.0015) -> Mesh:
     band's faces keep the UVs of the faces they copy. Returns a new Mesh.
     """
     assert mesh.uvs is not None and mesh.face_uvs is not None, "banded needs per-corner UVs"
-    edges, _ = boundary_edges(mesh.faces)
+    edges, owner = boundary_edges(mesh.faces)
     if len(edges) == 0:
         return mesh
     v = mesh.vertices.astype(np.float64)
@@ -479,7 +544,8 @@ def banded(mesh: Mesh, width=0.015, lift: float = 0.0015) -> Mesh:
     near, which = cKDTree(v[rim]).query(v)
     widths = np.asarray(width(v[rim]) if callable(width) else np.full(len(rim), width))
     inside = near < widths[which]
-    band = np.flatnonzero(inside[mesh.faces].all(axis=1))
+    band = _band_runs(mesh.faces, np.flatnonzero(inside[mesh.faces].all(axis=1)), v, edges,
+                      owner[:, 0])  # fmt: skip
     normals = vertex_normals(mesh.vertices, mesh.faces).astype(np.float64)
     n = len(v)
     copied = np.unique(np.concatenate([mesh.faces[band].ravel(), rim]))  # only these lift
@@ -500,6 +566,41 @@ def banded(mesh: Mesh, width=0.015, lift: float = 0.0015) -> Mesh:
     return Mesh(np.concatenate([v, lifted]).astype(np.float32),
                 np.concatenate(faces).astype(np.int32), uvs.astype(np.float32),
                 np.concatenate(face_uvs).astype(np.int32))  # fmt: skip
+
+
+# m of open edge a band must run along: where an edge's faces are wider than the band, one
+# or two narrower faces made a lone patch, 1.5 mm proud with lips on its sides only, that
+# rendered as a dark rectangle (two at the jacket's opening, at the waist).
+BAND_MIN_RUN = 0.08
+
+
+def _band_runs(faces: np.ndarray, band: np.ndarray, v: np.ndarray, edges: np.ndarray,
+               edge_face: np.ndarray) -> np.ndarray:  # fmt: skip
+    """The faces of ``band`` (B,) in runs (joined through shared edges) along at least
+    ``BAND_MIN_RUN`` m of the open ``edges`` (E, 2) (``edge_face`` (E,): each one's face)."""
+    if len(band) == 0:
+        return band
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = faces[band]
+    pairs = np.sort(np.stack([f, np.roll(f, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(band)), f.shape[1])
+    real = pairs[:, 0] != pairs[:, 1]
+    pairs, owner = pairs[real], owner[real]
+    _, key, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+    key = key.ravel()
+    order = np.argsort(key, kind="stable")
+    shared = (key[order][1:] == key[order][:-1]) & (count[key[order][1:]] == 2)
+    a, b = owner[order][:-1][shared], owner[order][1:][shared]
+    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(band), len(band)))
+    _, run = connected_components(graph, directed=False)
+    slot = np.full(len(faces), -1)
+    slot[band] = np.arange(len(band))
+    mine = slot[edge_face] >= 0
+    length = np.linalg.norm(v[edges[mine, 0]] - v[edges[mine, 1]], axis=1)
+    along = np.bincount(run[slot[edge_face[mine]]], length, minlength=run.max() + 1)
+    return band[along[run] >= BAND_MIN_RUN]
 
 
 def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:

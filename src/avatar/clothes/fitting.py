@@ -46,6 +46,8 @@ class Garment:
     bone_weights: the garment's own ``.mhw`` weights, or None to transfer the body's.
     thickness: m; > 0 solidifies the surface into a shell with hems.
     collide: False for face proxies (eyebrows, eyelashes) that sit on the skin by design.
+    swing_below: m (height on the authored mesh); a skirt's transferred skin weights are
+        smoothed over its cloth below it (``weights.swing``). None: as transferred.
     delete_verts: (D,) int32 base-mesh vertices the garment covers (hidden if the user asks).
     """
 
@@ -63,6 +65,7 @@ class Garment:
     tags: tuple[str, ...] = ()
     source: str = "builtin"
     licence: str = ""
+    swing_below: float | None = None
 
     @cached_property
     def anchor_cache(self) -> dict:
@@ -176,8 +179,25 @@ def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None
         result = weights.from_file(garment.bone_weights, names, len(garment.binding))
     else:
         result = weights.transfer(garment.binding, body_weights)
+        if garment.swing_below is not None:
+            result = weights.swing(result, garment.mesh, garment.swing_below)
     garment.weight_cache[:] = [(body_weights, names, result)]  # holds body_weights: no id reuse
     return result
+
+
+def _frame_weights(garment: Garment, w: SkinWeights) -> SkinWeights:
+    """(N, K) the weights frames skin ``garment``'s surface with: its 4 largest, except
+    where a skirt's weights ramp (``weights.swing``): there up to 8 bones each fade in and
+    out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices."""
+    limited = w.limit(FRAME_INFLUENCES)
+    if garment.swing_below is None or limited is w:
+        return limited
+    held = garment.mesh.vertices[:, 2] >= garment.swing_below
+    idx, wt = w.indices.copy(), w.weights.copy()
+    idx[held], wt[held] = 0, 0.0
+    k = limited.indices.shape[1]
+    idx[held, :k], wt[held, :k] = limited.indices[held], limited.weights[held]
+    return SkinWeights(idx, wt)
 
 
 def _with_shell(garment: Garment, inner: np.ndarray, q, w: SkinWeights):
@@ -299,7 +319,7 @@ def _dress(
             )
         )
         rests.append(inner)
-        ws.append(w.limit(FRAME_INFLUENCES))
+        ws.append(_frame_weights(garment, w))
         anchor, qo = _anchors(pose, garment, q, mesh)
         anchors.append(anchor)
         if qo is not None:
