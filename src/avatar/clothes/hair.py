@@ -210,6 +210,7 @@ def grow_cards(
     segments: int = 2,
     seed: int = 0,
     root: float = 0.0,
+    side_lift: float = 0.0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
 
@@ -230,6 +231,9 @@ def grow_cards(
     card then never rises below it. A buzz cut's cards lie over the cap all their length:
     rooted on the skin they came up through the cap half-way along, and each card's cut
     through it drew the outline of a scale.
+
+    ``side_lift``: m the cards rise further over the temples and ears (``side_volume``),
+    reached half-way along them: long hair's volume at the sides.
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
@@ -252,8 +256,9 @@ def grow_cards(
         step = _tangent(body, point, flow(point, centre, eye_z))
         # Rising evenly along the card (lying down from the root), not steeply at first:
         # a card whose first half rose at 15-25 degrees stood up from the scalp.
-        point = _above_skin(body, point + step * (size / segments)[:, None],
-                            start + (top - start) * (k / segments))  # fmt: skip
+        point = point + step * (size / segments)[:, None]
+        volume = side_lift * side_volume(point, centre, eye_z) * min(1.0, 2 * k / segments)
+        point = _above_skin(body, point, start + (top - start) * (k / segments) + volume)
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
@@ -313,6 +318,24 @@ def _strands(path: np.ndarray, normal: np.ndarray, width: float, rng
     return strands, np.cos(turn) * facing + np.sin(turn) * side
 
 
+SIDE_VOLUME_DEG = (45, 65, 115, 135)  # round the head: from the temples to behind the ears
+SIDE_VOLUME_Z = (0.035, 0.075)  # m above the eyes: full lift below the first, none above
+
+
+def side_volume(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+    """(N,) 0..1 where hair stands out from the head at the sides (points (N, 3)): over
+    the temples and ears (``SIDE_VOLUME_DEG`` round the head, easing in and out), up to
+    ``SIDE_VOLUME_Z`` above the eyes (fading out towards the crown) and all the way
+    down."""
+    turn = around(points, centre)
+    a, b, c, d = SIDE_VOLUME_DEG
+    round_ = np.clip((turn - a) / (b - a), 0, 1) * np.clip((d - turn) / (d - c), 0, 1)
+    low, high = SIDE_VOLUME_Z
+    up = np.clip((high - (points[:, 2] - eye_z)) / (high - low), 0, 1)
+    w = round_ * up
+    return w * w * (3 - 2 * w)
+
+
 def _shorten(path: np.ndarray, fraction: np.ndarray) -> np.ndarray:
     """(N, K, 3) paths resampled evenly (by sample index) over their first ``fraction``
     (N,) of their samples."""
@@ -339,6 +362,7 @@ def cards_on(
     strip: float = 0.12,
     clump: int = 0,
     stand: float = 0.0,
+    taper: float = 0.7,
 ) -> Piece:
     """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
     ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
@@ -359,7 +383,8 @@ def cards_on(
     about that many cards, each of its own length (70-130 %), whose tips are drawn
     together (``CLUMP_PULL``): locks with skin-dark gaps between their tips, as a beard's
     hair grows, instead of one even pile of cards. stand: how much a card's lift follows
-    its length (``reach``): 0 none, 1 a card twice as long stands twice as far out."""
+    its length (``reach``): 0 none, 1 a card twice as long stands twice as far out.
+    taper: a card's width at its tip over its width at the root."""
     rng = np.random.default_rng([seed, count])
     roots = _scatter(body, keep, 3 * count, rng)
     grow = np.ones(len(roots)) if density is None else np.asarray(density(roots), float)
@@ -389,8 +414,8 @@ def cards_on(
     # not together), so each clump reads as a lock against the next.
     u0 = None if group is None else (rng.uniform(0, 1, group.max() + 1)[group]
                                      + rng.uniform(0, 2 * strip, count))  # fmt: skip
-    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], strip=strip,
-                       u0=u0)  # fmt: skip
+    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], taper=taper,
+                       strip=strip, u0=u0)  # fmt: skip
 
 
 CLUMP_PULL = 0.8  # how far a clumped card's tip moves towards its clump's mean tip
@@ -540,6 +565,7 @@ def long_cards(
     layers=(0.004, 0.024),
     seed: int = 1,
     samples: int = 10,
+    side_lift: float = 0.0,
 ) -> Piece:
     """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
     stacked at random heights between ``layers`` (m) off the guides, of random length.
@@ -550,6 +576,8 @@ def long_cards(
     flat on one surface, read as one flat sheet of painted strands).
     Neighbours are only blended around the back and sides: never across the face.
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
+    ``side_lift``: m the locks stand at least off the head over the temples and ears
+    (``side_volume``; the crown keeps them on the scalp).
     """
     rng = np.random.default_rng([seed, count])
     # Samples closer together over the head, where the guides bend over the skull.
@@ -575,6 +603,11 @@ def long_cards(
     # Over the head each lock at its own height, up to 2 mm apart: laid at one height on
     # the scalp, the locks met there in one surface and shaded one another black.
     height = height + rng.uniform(0, 0.002, count)[:, None, None] * (1 - below)
+    # Volume over the temples and ears: lying there on the skull, long hair looked
+    # painted on from the side.
+    centre, _ = head_frame(body)
+    volume = side_lift * side_volume(path.reshape(-1, 3), centre, eye_z).reshape(path.shape[:2])
+    height = np.maximum(height, volume[..., None] * rng.uniform(0.7, 1.0, count)[:, None, None])
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
@@ -754,8 +787,12 @@ def hang_cards(
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
     path = _fall_clear(_no_lone_locks(path, centre, eye_z + 0.03), centre, eye_z + 0.03)
+    # Drawn in under the ears on a path three times as fine (a straight 3.5 cm segment
+    # from above the ear to a point drawn in below it cut in across the ear's level).
+    fine = _finer(path, 3)
+    fine = _hang_in(body, fine, centre, eye_z - 0.055)
     stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
-    path = _curl_in(body, _cut_at(path, stop), centre)
+    path = _curl_in(body, _cut_at(fine, stop)[:, ::3], centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
@@ -777,6 +814,42 @@ def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarra
     out = path.copy()
     out[..., :2] = centre[:2] + rel * scale[..., None]
     return out
+
+
+def _finer(path: np.ndarray, times: int) -> np.ndarray:
+    """(N, (K - 1) * times + 1, 3) the paths (N, K, 3) with ``times - 1`` points put evenly
+    between each pair of their points (the same polylines)."""
+    t = np.linspace(0, path.shape[1] - 1, (path.shape[1] - 1) * times + 1)
+    j = np.minimum(t.astype(int), path.shape[1] - 2)
+    f = (t - j)[None, :, None]
+    return path[:, j] * (1 - f) + path[:, j + 1] * f
+
+
+HANG_GAP_M = 0.012  # hanging hair below the ears: at most this far off the neck and jaw
+HANG_PULL_M = 0.045  # ... reached over this drop below the ears
+
+
+def _hang_in(body: AuthoringBody, path: np.ndarray, centre: np.ndarray,
+             below: float) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) hanging paths drawn in towards the head's vertical axis (through
+    ``centre``) below the height ``below`` (under the ears), behind the cheeks, until they
+    hang at most ``HANG_GAP_M`` off the skin, reached gradually over ``HANG_PULL_M`` of
+    drop: hair falls past the ears and then in against the neck and jaw under its weight.
+    (Falling straight down from the ears' width, a bob's side locks hung 3.5 cm off the
+    neck and stood out from it seen from behind.) Kept 3 mm off the skin."""
+    out = path.reshape(-1, 3).copy()
+    drop = np.clip((below - out[:, 2]) / HANG_PULL_M, 0, 1)
+    side = np.clip((around(out, centre) - 50) / 30, 0, 1)  # not over the cheeks
+    weight = (drop * drop * (3 - 2 * drop)) * side
+    moved = weight > 0
+    for _ in range(3):  # the skin is not straight in: step in, measure again
+        gap, _ = body.skin_tree.query(out)
+        shift = np.maximum(gap - HANG_GAP_M, 0) * weight
+        rel = out[:, :2] - centre[:2]
+        radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+        out[:, :2] = centre[:2] + rel * (np.maximum(radius - shift, 0) / radius)[:, None]
+        out[moved] = _off_skin(body, out[moved], 0.003)
+    return out.reshape(path.shape)
 
 
 def _no_lone_locks(path: np.ndarray, centre: np.ndarray, below: float,
