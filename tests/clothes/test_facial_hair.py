@@ -500,3 +500,11 @@ def test_dark_beard_shows_its_colour():
 def _linear(srgb_u8: np.ndarray) -> np.ndarray:
     s = srgb_u8.astype(np.float64) / 255
     return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+
+
+def test_beard_cards_have_little_sheen():
+    """A beard asks the renderer for little fibre rim (Principled sheen): at scalp hair's
+    0.25 (no hint), clumps lying at a grazing angle under the lip and on the chin lit up
+    whole, grey flakes on a dark beard."""
+    extras = load_garment("beard-short", texture_size=64).material.extras
+    assert float(extras.get("sheen", 0.25)) <= 0.1

@@ -138,21 +138,38 @@ CAP_RIM_M = 0.0003  # the cap's rim lies this far off the skin ...
 CAP_TUCK_M = 0.008  # ... rising to its ease over this much height above the hairline
 
 
-def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:
+def base_cap(body: AuthoringBody, ease: float = 0.002, soft: float = 0.0) -> Piece:
     """The scalp inside the hairline as a dense hair surface (what shows between cards),
     ``ease`` m off the skin but tucked down to it at the hairline (``CAP_RIM_M``): a rim
     standing 1.5-2 mm off the forehead cast a dark line along a buzz cut's hairline, the
-    edge of a cap."""
+    edge of a cap.
+
+    soft: m above the hairline over which the cap's v runs down to 0.5 at its rim (0:
+    ``cap_uvs`` everywhere), where a buzz cut's texture (``looks.textures.buzz_material``)
+    thins its hairs out: a soft hairline, not the edge of a cap."""
     faces = body.skin_faces
     centre, eye_z = head_frame(body)
 
+    def above(points: np.ndarray) -> np.ndarray:
+        return points[:, 2] - eye_z - np.interp(around(points, centre), HAIRLINE_DEG, HAIRLINE_M)
+
     def lift(points: np.ndarray, arm, leg) -> np.ndarray:
-        line = eye_z + np.interp(around(points, centre), HAIRLINE_DEG, HAIRLINE_M)
-        rise = np.clip((points[:, 2] - line) / CAP_TUCK_M, 0, 1)
+        rise = np.clip(above(points) / CAP_TUCK_M, 0, 1)
         return CAP_RIM_M + (ease - CAP_RIM_M) * rise * rise * (3 - 2 * rise)
 
     mesh = cut(body, faces, hairline_mask(body), lift, relax=8)
-    return bound(body, cap_uvs(mesh, centre), faces)
+    capped = cap_uvs(mesh, centre)
+    if soft > 0:  # by the distance to the cap's rim: the hairline and round the ears
+        from scipy.spatial import cKDTree
+
+        rim = mesh.vertices[np.unique(boundary_edges(mesh.faces)[0])].astype(np.float64)
+        corners = mesh.vertices[mesh.faces].reshape(-1, 3).astype(np.float64)
+        rise = np.clip(cKDTree(rim).query(corners)[0] / soft, 0, 1)
+        assert capped.uvs is not None  # ``cap_uvs`` gives every corner one
+        uv = capped.uvs.copy()
+        uv[:, 1] = 0.5 + (uv[:, 1] - 0.5) * np.sqrt(rise)
+        capped = per_corner(mesh, uv)
+    return bound(body, capped, faces)
 
 
 CROWN_OFFSET = (0.0, 0.035, 0.1)  # the crown (whorl) from the skull centre at eye height (m)
@@ -211,6 +228,7 @@ def grow_cards(
     seed: int = 0,
     root: float = 0.0,
     side_lift: float = 0.0,
+    thin: float = 0.0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
 
@@ -234,11 +252,16 @@ def grow_cards(
 
     ``side_lift``: m the cards rise further over the temples and ears (``side_volume``),
     reached half-way along them: long hair's volume at the sides.
+    ``thin``: m above the hairline over which the cards thin out (a root kept with the
+    probability of its height over it there): a buzz cut's soft hairline.
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
     roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
     depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
+    if thin > 0:
+        kept = rng.uniform(size=count) < np.clip(depth / thin, 0.1, 1)
+        roots, depth, count = roots[kept], depth[kept], int(kept.sum())
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
     # Hair lies flat at the crown, where it parts round the whorl.
     crown = centre + np.asarray(CROWN_OFFSET)
@@ -319,19 +342,22 @@ def _strands(path: np.ndarray, normal: np.ndarray, width: float, rng
 
 
 SIDE_VOLUME_DEG = (45, 65, 115, 135)  # round the head: from the temples to behind the ears
-SIDE_VOLUME_Z = (0.035, 0.075)  # m above the eyes: full lift below the first, none above
+# m above the eyes: no lift below the first, full from the second to the third (above the
+# ears and over the temples), none above the fourth (the crown). Lifted down over the ear
+# itself too, a card's vertex bound there came 6.3 mm inside a child's ear.
+SIDE_VOLUME_Z = (-0.03, 0.0, 0.035, 0.075)
 
 
 def side_volume(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
-    """(N,) 0..1 where hair stands out from the head at the sides (points (N, 3)): over
-    the temples and ears (``SIDE_VOLUME_DEG`` round the head, easing in and out), up to
-    ``SIDE_VOLUME_Z`` above the eyes (fading out towards the crown) and all the way
-    down."""
+    """(N,) 0..1 where hair stands out from the head at the sides (points (N, 3)): above
+    the ears and over the temples (``SIDE_VOLUME_DEG`` round the head, ``SIDE_VOLUME_Z``
+    above the eyes, easing in and out: not down on the shoulders, nor on the crown)."""
     turn = around(points, centre)
     a, b, c, d = SIDE_VOLUME_DEG
     round_ = np.clip((turn - a) / (b - a), 0, 1) * np.clip((d - turn) / (d - c), 0, 1)
-    low, high = SIDE_VOLUME_Z
-    up = np.clip((high - (points[:, 2] - eye_z)) / (high - low), 0, 1)
+    z = points[:, 2] - eye_z
+    low, full, fading, high = SIDE_VOLUME_Z
+    up = np.clip((z - low) / (full - low), 0, 1) * np.clip((high - z) / (high - fading), 0, 1)
     w = round_ * up
     return w * w * (3 - 2 * w)
 
@@ -607,7 +633,8 @@ def long_cards(
     # painted on from the side.
     centre, _ = head_frame(body)
     volume = side_lift * side_volume(path.reshape(-1, 3), centre, eye_z).reshape(path.shape[:2])
-    height = np.maximum(height, volume[..., None] * rng.uniform(0.7, 1.0, count)[:, None, None])
+    vary = np.random.default_rng([seed, count, 11]).uniform(0.7, 1.0, count)  # (own stream)
+    height = np.maximum(height, volume[..., None] * vary[:, None, None])
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal

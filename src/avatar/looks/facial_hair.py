@@ -110,7 +110,7 @@ def beard_material(spec, size: int = 1024) -> Material:
     # one even mat.
     under = colour[: size - half, :, :3].astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
-    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY}
+    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY, "sheen": BEARD_SHEEN}
     return replace(m, base_color_texture=colour, extras=extras)
 
 
@@ -150,6 +150,10 @@ def _even_cards(rgb: np.ndarray) -> np.ndarray:
 # clumps lit from behind by the key light glowed white, flakes of cotton wool. (A share of
 # the light since the Translucent BSDF is mixed in, not added: scalp hair's is 0.3.)
 BEARD_TRANSLUCENCY = 0.1
+# The fibre rim (Principled sheen) on a beard's cards: at scalp hair's 0.25 a clump lying
+# at a grazing angle to the camera (under the lip, on the chin) lit up as a whole, a grey
+# flake on a dark beard.
+BEARD_SHEEN = 0.05
 
 
 def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
