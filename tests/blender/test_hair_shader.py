@@ -32,7 +32,11 @@ def test_hair_material_is_anisotropic_along_the_strands(empty_scene, hair_record
     # Base colour straight from the image (FBX/USD follow only that link), specular tinted.
     colour = bsdf.inputs["Base Color"].links[0].from_node
     assert colour.type == "TEX_IMAGE"
-    assert bsdf.inputs["Specular Tint"].links[0].from_node == colour
+    # The highlight tinted by a light version of the colour (a power under one): tinted
+    # by the colour itself, dark hair had no highlight at all.
+    tint = bsdf.inputs["Specular Tint"].links[0].from_node
+    assert tint.type == "GAMMA" and tint.inputs["Color"].links[0].from_node == colour
+    assert 0.03 ** tint.inputs["Gamma"].default_value > 0.3
     assert bsdf.inputs["Sheen Weight"].default_value > 0
     # Duller at the roots (v = 0.5) than at the tips (v = 0).
     fade = bsdf.inputs["Specular IOR Level"].links[0].from_node

@@ -80,15 +80,64 @@ def test_hair_translucency_keeps_the_cut_out_and_the_exporters_view(empty_scene)
     assert cut.type == "MIX_SHADER"
     assert cut.inputs["Fac"].links[0].from_socket == bsdf.inputs["Alpha"].links[0].from_socket
     assert cut.inputs[1].links[0].from_node.type == "BSDF_TRANSPARENT"
-    fibre = cut.inputs[2].links[0].from_node  # added: front-lit cards lose no reflection
-    assert fibre.type == "ADD_SHADER" and fibre.inputs[0].links[0].from_node == bsdf
-    through = fibre.inputs[1].links[0].from_node
+    fibre = cut.inputs[2].links[0].from_node  # mixed (was added): energy-conserving
+    assert fibre.type == "MIX_SHADER" and fibre.inputs[1].links[0].from_node == bsdf
+    through = fibre.inputs[2].links[0].from_node
     assert through.type == "BSDF_TRANSLUCENT"
     tint = through.inputs["Color"].links[0].from_node
-    assert tint.inputs[0].links[0].from_node.type == "TEX_IMAGE"
+    assert tint.inputs["Color"].links[0].from_node.type == "TEX_IMAGE"
+    # The translucent share and the Principled BSDF's add up to one, and the translucent
+    # colour stays within 0..1 (the hair's own to a power at most 1).
+    share = fibre.inputs["Fac"].default_value
+    assert not fibre.inputs["Fac"].links and 0 < share <= 0.5
+    assert tint.type == "GAMMA" and 0 < tint.inputs["Gamma"].default_value <= 1.0
     assert PrincipledBSDFWrapper(mat, is_readonly=True).node_principled_bsdf == bsdf
     cloth = materials.material(_cloth())
     assert all(n.target == "ALL" for n in cloth.node_tree.nodes if n.type == "OUTPUT_MATERIAL")
+
+
+def test_white_hair_sends_on_no_more_light_than_it_receives(empty_scene, tmp_path):
+    """A white hair card in a white furnace (a uniform world of brightness 1 lights both
+    sides, no other light) is at most as bright as the world: 1.29 when the Translucent
+    BSDF was added to the Principled BSDF (light reflected and passed through at once),
+    0.80 mixed."""
+    import bpy
+
+    from avatar.blender import materials, render
+
+    record = _hair_record()
+    record.base_color_texture[..., :3] = 255
+    furnace = bpy.data.scenes.new("furnace")  # a scene of its own: later tests keep theirs
+    try:
+        mesh = bpy.data.meshes.new("card")
+        mesh.from_pydata([(-1, 0, -1), (1, 0, -1), (1, 0, 1), (-1, 0, 1)], [], [(0, 1, 2, 3)])
+        mesh.uv_layers.new(name="UVMap")
+        mesh.uv_layers["UVMap"].data.foreach_set("uv", [0, 0.5, 1, 0.5, 1, 0.9, 0, 0.9])
+        card = bpy.data.objects.new("card", mesh)
+        card.data.materials.append(materials.material(record))
+        furnace.collection.objects.link(card)
+        cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
+        cam.location, cam.rotation_euler = (0, -4, 0), (math.pi / 2, 0, 0)
+        furnace.collection.objects.link(cam)
+        furnace.camera = cam
+        furnace.world = bpy.data.worlds.new("white")
+        if furnace.world.node_tree is None:  # Blender < 5: worlds start without nodes
+            furnace.world.use_nodes = True
+        background = furnace.world.node_tree.nodes["Background"]
+        background.inputs["Color"].default_value = (1, 1, 1, 1)
+        background.inputs["Strength"].default_value = 1.0
+        render.configure(furnace, "CYCLES", 16, 16)
+        furnace.view_settings.view_transform = "Standard"  # linear radiance, unclipped
+        furnace.render.image_settings.file_format = "OPEN_EXR"
+        tmp_path.mkdir(parents=True, exist_ok=True)
+        furnace.render.filepath = str(tmp_path / "card.exr")
+        bpy.ops.render.render(write_still=True, scene=furnace.name)
+        image = bpy.data.images.load(str(tmp_path / "card.exr"))
+        pixels = np.array(image.pixels[:], np.float32).reshape(16, 16, 4)
+    finally:
+        bpy.data.scenes.remove(furnace)
+    brightness = float(pixels[6:10, 6:10, :3].mean())
+    assert brightness <= 1.02, brightness
 
 
 def _cloth():
@@ -122,7 +171,6 @@ def test_beard_passes_less_light_than_scalp_hair(empty_scene):
 
     def amount(name):
         mat = materials.material(load_garment(name, texture_size=64).material)
-        through = next(n for n in mat.node_tree.nodes if n.type == "BSDF_TRANSLUCENT")
-        return through.inputs["Color"].links[0].from_node.inputs["Scale"].default_value
+        return mat.node_tree.nodes["Hair Translucency"].inputs["Fac"].default_value
 
     assert amount("beard-short") < 0.5 * amount("hair-short")

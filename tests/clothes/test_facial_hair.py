@@ -439,3 +439,72 @@ def test_grey_beard_greys_hair_by_hair_not_in_streaks():
     grey = tex[:128, :, :3].astype(float).mean(-1) > 100
     mixed = ~(grey.all(axis=0) | (~grey).all(axis=0))  # columns partly grey, partly not
     assert 0.2 < grey.mean() < 0.95 and mixed.mean() > 0.5
+
+
+def test_short_beard_clumps_taper_to_points(frame):
+    """A beard card narrows to under half its root's width at its tip, and is some 3 mm
+    wide: 4.4 mm cards ending at 70 % of it laid blunt, rounded clump ends over the next
+    clump's roots, read as scales."""
+    body, _ = frame
+    v = face.beard_cards(body).mesh.vertices.reshape(-1, 2, 2, 3).astype(np.float64)
+    root = np.linalg.norm(v[:, 1, 0] - v[:, 0, 0], axis=1)
+    tip = np.linalg.norm(v[:, 1, 1] - v[:, 0, 1], axis=1)
+    assert np.median(tip / root) < 0.45, np.median(tip / root)  # was 0.7
+    assert np.median(root) < 0.0036, np.median(root)  # was 4.2 mm
+
+
+def test_beard_cards_draw_single_fine_hairs():
+    """Across a beard card's rows the opaque texels come in single hairs (runs of at
+    most a hair's 3 texels at 1024 px: kept neighbours merged into ribbons up to 14 texels
+    wide, flakes), as light at the tips as at the roots within a third (scalp hair's
+    lightening, 1.77 times, drew each clump as a scale with a light rim)."""
+    material = load_garment("beard-short", texture_size=1024).material
+    texture = material.base_color_texture
+    cards = texture[512:]
+    runs = []
+    for row in cards[8:-8:16, :, 3] > 127:
+        edges = np.diff(np.r_[0, row.astype(int), 0])
+        runs.append(np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1))
+    runs = np.concatenate(runs)
+    assert len(runs) > 1000 and runs.max() <= 3, runs.max()
+    lum = _linear(cards[..., :3]) @ np.array([0.2126, 0.7152, 0.0722])
+    shown = cards[..., 3] > 127
+    root, tip = (np.median(lum[rows][shown[rows]]) for rows in (slice(8, 90), slice(380, 480)))
+    assert tip < 1.3 * root, tip / root
+
+
+def test_dark_beard_shows_its_colour():
+    """A black-haired man's beard has the albedo of real dark hair (linear luminance at
+    least 0.015 in its undercoat and cards: 0.0095 in the undercoat, near black), a dark
+    brown beard stays brown (red over blue), and an old man's grey beard has grey, not
+    white, hairs (none over 0.9: a fifth of its card texels were 1.0, cotton wool)."""
+    from avatar.looks import facial_hair
+
+    material = load_garment("beard-short", texture_size=256).material
+    weights = np.array([0.2126, 0.7152, 0.0722])
+
+    def shown(colour, age=0.45):
+        tex = facial_hair.for_wearer(material, "cards", age, colour).base_color_texture
+        lin = _linear(tex[..., :3])
+        return [lin[rows][tex[rows, :, 3] > 127] for rows in (slice(0, 128), slice(128, 256))]
+
+    for texels in shown("black hair"):
+        assert np.median(texels @ weights) > 0.015, np.median(texels @ weights)
+    for texels in shown("dark brown hair"):
+        red, _, blue = np.median(texels, axis=0)
+        assert red > 2.5 * blue and 0.02 < np.median(texels @ weights) < 0.1
+    grey = np.concatenate(shown("dark brown hair", age=1.0)) @ weights
+    assert grey.max() < 0.9, (grey > 0.9).mean()
+
+
+def _linear(srgb_u8: np.ndarray) -> np.ndarray:
+    s = srgb_u8.astype(np.float64) / 255
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+
+
+def test_beard_cards_have_little_sheen():
+    """A beard asks the renderer for little fibre rim (Principled sheen): at scalp hair's
+    0.25 (no hint), clumps lying at a grazing angle under the lip and on the chin lit up
+    whole, grey flakes on a dark beard."""
+    extras = load_garment("beard-short", texture_size=64).material.extras
+    assert float(extras.get("sheen", 0.25)) <= 0.1

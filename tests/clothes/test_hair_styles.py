@@ -200,6 +200,21 @@ def test_bob_has_no_lone_locks_over_the_ears(body):
     assert np.percentile(out, 99) < 0.015 and out.max() < 0.02, (np.percentile(out, 99), out.max())
 
 
+def test_bob_side_locks_hang_in_against_the_neck(body):
+    """Seen from behind, a bob's locks at the sides (behind the cheeks, 70-130 degrees
+    round the head) hang in against the jaw and neck at the level of their ends: their
+    points there lie within 1.5 cm of the skin in the median (they fell straight down
+    from the ears' width, 3.5 cm off the neck: a gap under locks standing out)."""
+    centre, eye_z = hair.head_frame(body)
+    lines = hair.hang_cards(body, hair.flow_parted()).mesh.vertices.reshape(-1, 2, 11, 3)
+    points = lines.mean(axis=1).astype(np.float64).reshape(-1, 3)
+    turn = hair.around(points, centre)
+    low = (turn > 70) & (turn < 130) & (points[:, 2] < eye_z - 0.07)
+    gap, _ = body.skin_tree.query(points[low])
+    assert low.sum() > 150
+    assert np.median(gap) < 0.015, np.median(gap)  # was 0.035
+
+
 def test_long_hair_lies_on_the_scalp_over_the_head(body):
     """Over the head the long locks lie on the scalp, under the hair grown there (they
     hung from MakeHuman's hair ribbons, which stand off the crown, and lifted at once:
@@ -213,6 +228,24 @@ def test_long_hair_lies_on_the_scalp_over_the_head(body):
     height = collision.query(body.vertices[:13380], surface, top).distance
     assert len(top) > 500
     assert np.median(height) < 0.006 and np.percentile(height, 90) < 0.012
+
+
+def test_long_hair_has_volume_over_the_ears(body):
+    """From the side, long hair stands off the head over the temples and ears (60-120
+    degrees round it, up to 3 cm above the eyes): a centimetre off the skin in the median
+    (4.9 mm: it lay on the skull there like paint), while the crown keeps it on the scalp
+    (``test_long_hair_lies_on_the_scalp_over_the_head``)."""
+    from avatar.geometry import collision
+
+    centre, eye_z = hair.head_frame(body)
+    surface = collision.skin_surface(body.base.faces[body.base.face_groups["body"]])
+    v = load_garment("hair-long", texture_size=64).mesh.vertices.astype(np.float64)
+    turn = hair.around(v, centre)
+    side = (turn > 60) & (turn < 120) & (v[:, 2] > eye_z) & (v[:, 2] < eye_z + 0.03)
+    height = collision.query(body.vertices[:13380], surface, v[side]).distance
+    assert side.sum() > 100
+    assert np.median(height) > 0.01, np.median(height)
+    assert np.percentile(height, 90) < 0.025  # volume, not a helmet
 
 
 def test_long_hair_roots_do_not_stack_up_at_the_crown(body):

@@ -112,11 +112,13 @@ def _new_material(record, fallback_name: str) -> bpy.types.Material:
 # v = 0.5 to tip v = 0, scalp caps bottom to top, lashes lid to tip; ``looks.textures``).
 HAIR_ANISOTROPY = 0.8  # how stretched the highlight is across the strands (0..1)
 HAIR_SHEEN = 0.25  # the soft fibre rim seen at grazing angles
-# Share of light a hair card passes through to its far side (a Translucent BSDF added,
+# Share of light a hair card passes through to its far side (a Translucent BSDF mixed in,
 # in Cycles): hair is a bundle of thin fibres, not a sheet, and lit from behind or through
 # the layers above it glows in its own colour. Opaque cards shadowed each other: long hair
 # hanging below the ears rendered darker than short hair of the same colour.
-HAIR_TRANSLUCENCY = 0.6  # a ``translucency`` hint in a record's extras overrides it
+HAIR_TRANSLUCENCY = 0.3  # a ``translucency`` hint in a record's extras overrides it
+HAIR_TINT_GAMMA = 0.25  # the highlight's tint: the hair's colour ** this (0.03 -> 0.42)
+HAIR_THROUGH_GAMMA = 0.5  # the colour of light through hair: the hair's colour ** this
 UV_MAP = "UVMap"  # the layer ``blender.mesh`` makes
 
 
@@ -135,10 +137,11 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
 
     The highlight is stretched across the strands: the tangent comes from the UV map (its
     u direction) rotated a quarter turn (``Anisotropic Rotation`` 0.25) onto v, along which
-    the strands run. The specular is tinted by the hair's own colour (the coloured second
-    highlight of real hair) and fades towards the roots of the cards (v = 0.5, in the shade
-    of the hair above them); a little sheen gives the soft rim of fibres. Base colour and
-    alpha stay wired straight from the texture (exporters follow that link).
+    the strands run. The specular is tinted by a light version of the hair's own colour
+    (the coloured second highlight of real hair) and fades towards the roots of the cards
+    (v = 0.5, in the shade of the hair above them); a little sheen gives the soft rim of
+    fibres. Base colour and alpha stay wired straight from the texture (exporters follow
+    that link).
     """
     amount = float(record.extras.get("anisotropy", HAIR_ANISOTROPY))
     bsdf.inputs["Anisotropic"].default_value = amount
@@ -151,7 +154,15 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
         bsdf.inputs["Sheen Roughness"].default_value = 0.4
     colour = bsdf.inputs["Base Color"].links
     if colour and "Specular Tint" in bsdf.inputs:
-        tree.links.new(colour[0].from_socket, bsdf.inputs["Specular Tint"])
+        # Tinted by a light version of the hair's colour (its ``HAIR_TINT_GAMMA`` power):
+        # tinted by the colour itself, dark hair (albedo ~0.03) had no highlight at all and
+        # a dark brown beard rendered as a black mat.
+        tint = tree.nodes.new("ShaderNodeGamma")
+        tint.name = tint.label = "Hair Specular Tint"
+        tint.location = (-300, -350)
+        tint.inputs["Gamma"].default_value = HAIR_TINT_GAMMA
+        tree.links.new(colour[0].from_socket, tint.inputs["Color"])
+        tree.links.new(tint.outputs["Color"], bsdf.inputs["Specular Tint"])
     # Roots darker in the highlight: v in [0, 0.5] runs tip to root on the cards; the
     # scalp caps (v > 0.5) are all root.
     uv = tree.nodes.new("ShaderNodeUVMap")
@@ -174,28 +185,36 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
 
 
 def translucency(tree, bsdf: bpy.types.Node, amount: float = HAIR_TRANSLUCENCY) -> None:
-    """Cycles shades a hair material as its Principled BSDF plus a Translucent BSDF in
-    ``amount`` times the hair's colour (light through the card from its far side; added,
-    not mixed in, so a card lit from the front keeps all its reflection), cut out by the
-    same alpha, on a Material Output of its own (target Cycles). The Principled BSDF stays
-    wired to the material's first output (target All): EEVEE draws it, and the FBX and USD
-    exporters look for a Principled BSDF linked straight to an output."""
+    """Cycles shades a hair material as its Principled BSDF mixed with a Translucent BSDF
+    in the hair's colour (light through the card from its far side), the translucent share
+    ``amount`` of the light and the Principled BSDF the rest: mixed, not added, so a card
+    never sends on more light than reaches it (added, a light blond card lit from the front
+    and behind at once reflected some 1.3 times the light it received). It is cut out by
+    the same alpha, on a Material Output of its own (target Cycles). The Principled BSDF
+    stays wired to the material's first output (target All): EEVEE draws it, and the FBX
+    and USD exporters look for a Principled BSDF linked straight to an output."""
     nodes, links = tree.nodes, tree.links
-    tint = nodes.new("ShaderNodeVectorMath")
-    tint.operation, tint.location = "SCALE", (0, -450)
-    tint.inputs["Scale"].default_value = amount
+    share = float(np.clip(amount, 0.0, 1.0))
+    # Light through a fibre crosses it once, where light reflected diffusely from the hair
+    # has crossed many: the transmitted colour is the hair's own raised to a power below
+    # one (lighter, more saturated, never above 1: ``HAIR_THROUGH_GAMMA``).
+    tint = nodes.new("ShaderNodeGamma")
+    tint.location = (0, -450)
+    tint.inputs["Gamma"].default_value = HAIR_THROUGH_GAMMA
     colour = bsdf.inputs["Base Color"]
     if colour.links:
-        links.new(colour.links[0].from_socket, tint.inputs[0])
+        links.new(colour.links[0].from_socket, tint.inputs["Color"])
     else:
-        tint.inputs[0].default_value = tuple(colour.default_value)[:3]
+        tint.inputs["Color"].default_value = tuple(colour.default_value)
     through = nodes.new("ShaderNodeBsdfTranslucent")
     through.location = (200, -450)
-    links.new(tint.outputs["Vector"], through.inputs["Color"])
-    fibre = nodes.new("ShaderNodeAddShader")
+    links.new(tint.outputs["Color"], through.inputs["Color"])
+    fibre = nodes.new("ShaderNodeMixShader")
+    fibre.name = fibre.label = "Hair Translucency"
     fibre.location = (450, -250)
-    links.new(bsdf.outputs["BSDF"], fibre.inputs[0])
-    links.new(through.outputs["BSDF"], fibre.inputs[1])
+    fibre.inputs["Fac"].default_value = share
+    links.new(bsdf.outputs["BSDF"], fibre.inputs[1])
+    links.new(through.outputs["BSDF"], fibre.inputs[2])
     # Cut out where the Principled BSDF is (its alpha), so the gaps between strands stay
     # see-through: the Translucent BSDF has no alpha of its own.
     cut_out = nodes.new("ShaderNodeMixShader")

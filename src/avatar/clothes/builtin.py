@@ -154,6 +154,10 @@ def spread_across(body: AuthoringBody, mesh: Mesh, passes: int = 8) -> Mesh:
 BUZZ_CARDS = 2400
 BUZZ_WIDTH = 0.0045  # m
 BUZZ_ROOT = 0.0022  # m above the skin
+BUZZ_HAIRLINE_M = 0.012  # the buzz cut's stubble thins out over this much above the hairline
+# Long hair's volume over the temples and ears (``hair.side_volume``): lying on the skull
+# there, it looked painted on from the side.
+LONG_SIDE_LIFT_M = 0.008
 
 MIDLINE_SPAN = 0.04  # m either side of the midplane where loose cloth spans a cleft
 
@@ -739,9 +743,9 @@ SPECS = [
     Spec("boots", "footwear", lambda b: shoes.shoes(b, top=0.86), "leather", "brown", 0.0025, 30, ("boots", "ankle boots", "laced"), look=shoes.look("calf", "dark brown", "sole", "sole black")),  # noqa: E501
     Spec("cap", "headwear", _cap, "canvas", "red", 0.0, 80, ("cap", "hat", "baseball")),
     Spec("hair-short", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_crown())]), "hair", "dark brown hair", 0.0, 70, ("hair", "short")),  # noqa: E501
-    Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4), hair.long_cards(b)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
+    Spec("hair-long", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.1, 0.16), 0.025, (0.004, 0.012), 4, side_lift=LONG_SIDE_LIFT_M), hair.long_cards(b, side_lift=LONG_SIDE_LIFT_M)]), "hair", "blond hair", 0.0, 70, ("hair", "long")),  # noqa: E501
     Spec("hair-ponytail", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied(), 480, (0.08, 0.14), 0.015, (0.003, 0.01), 4), hair.ponytail(b)]), "hair", "black hair", 0.0, 70, ("hair", "tied back", "ponytail")),  # noqa: E501
-    Spec("hair-buzz", "hair", lambda b: join([hair.base_cap(b, 0.0015), hair.grow_cards(b, hair.flow_crown(sweep=0.0), BUZZ_CARDS, (0.005, 0.009), BUZZ_WIDTH, (0.0024, 0.003), 1, root=BUZZ_ROOT)]), "hair", "dark brown hair", 0.0, 70, ("hair", "buzz", "short", "men")),  # noqa: E501
+    Spec("hair-buzz", "hair", lambda b: join([hair.base_cap(b, 0.0015, soft=BUZZ_HAIRLINE_M), hair.grow_cards(b, hair.flow_crown(sweep=0.0), BUZZ_CARDS, (0.005, 0.009), BUZZ_WIDTH, (0.0024, 0.003), 1, root=BUZZ_ROOT, thin=BUZZ_HAIRLINE_M)]), "hair", "dark brown hair", 0.0, 70, ("hair", "buzz", "short", "men"), look=textures.buzz_material),  # noqa: E501
     Spec("hair-bob", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_parted(), 300, (0.06, 0.1), 0.025, (0.004, 0.014), 4), hair.hang_cards(b, hair.flow_parted())]), "hair", "auburn hair", 0.0, 70, ("hair", "bob", "fringe")),  # noqa: E501
     Spec("hair-bun", "hair", lambda b: join([hair.base_cap(b), hair.grow_cards(b, hair.flow_tied((0.0, 0.06, 0.075)), 360, (0.08, 0.14), 0.025, (0.003, 0.007), 4), hair.bun(b)]), "hair", "grey hair", 0.0, 70, ("hair", "bun", "tied back", "elderly")),  # noqa: E501
     Spec("eyebrows", "face", face.eyebrows, "hair", "dark brown hair", 0.0, 5, ("eyebrows",), False),  # noqa: E501

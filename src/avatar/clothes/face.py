@@ -373,10 +373,11 @@ def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -
 
     return join([
         cards_on(body, keep & upper, flow, int(count * share), length, BEARD_CARD_M, lift,
-                 segments=1, density=density, strip=BEARD_STRIP, clump=BEARD_CLUMP),
+                 segments=1, density=density, strip=BEARD_STRIP, clump=BEARD_CLUMP,
+                 taper=BEARD_TAPER),
         cards_on(body, keep & ~upper, flow, count - int(count * share), length, BEARD_CARD_M,
                  lift, segments=1, seed=2, density=density, strip=BEARD_STRIP,
-                 reach=beard_reach(body), clump=BEARD_CLUMP, stand=0.8),
+                 reach=beard_reach(body), clump=BEARD_CLUMP, stand=0.8, taper=BEARD_TAPER),
     ])  # fmt: skip
 
 
@@ -428,7 +429,11 @@ def beard_strays(body: AuthoringBody, count: int = 480) -> Piece:
                     strip=BEARD_STRAY_STRIP)  # fmt: skip
 
 
-BEARD_CARD_M = 0.0044  # a beard card's width
+BEARD_CARD_M = 0.0034  # a beard card's width at its root
+# ... and at its tip, this share of it: a clump of cards ends in a point of a few hairs.
+# Cards 4.4 mm wide ending at 70 % of it laid blunt, rounded tips over the next clump's
+# roots, and the beard read as scales (flakes) rather than hair.
+BEARD_TAPER = 0.3
 # A beard or moustache card shows this share of the hair texture's width: some six of
 # its kept hairs, each a few tenths of a millimetre (facial hair is coarse). Scalp cards'
 # 0.12 drew some forty hairs a tenth as thick, under a pixel at any distance: a felt.

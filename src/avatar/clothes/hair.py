@@ -138,21 +138,38 @@ CAP_RIM_M = 0.0003  # the cap's rim lies this far off the skin ...
 CAP_TUCK_M = 0.008  # ... rising to its ease over this much height above the hairline
 
 
-def base_cap(body: AuthoringBody, ease: float = 0.002) -> Piece:
+def base_cap(body: AuthoringBody, ease: float = 0.002, soft: float = 0.0) -> Piece:
     """The scalp inside the hairline as a dense hair surface (what shows between cards),
     ``ease`` m off the skin but tucked down to it at the hairline (``CAP_RIM_M``): a rim
     standing 1.5-2 mm off the forehead cast a dark line along a buzz cut's hairline, the
-    edge of a cap."""
+    edge of a cap.
+
+    soft: m above the hairline over which the cap's v runs down to 0.5 at its rim (0:
+    ``cap_uvs`` everywhere), where a buzz cut's texture (``looks.textures.buzz_material``)
+    thins its hairs out: a soft hairline, not the edge of a cap."""
     faces = body.skin_faces
     centre, eye_z = head_frame(body)
 
+    def above(points: np.ndarray) -> np.ndarray:
+        return points[:, 2] - eye_z - np.interp(around(points, centre), HAIRLINE_DEG, HAIRLINE_M)
+
     def lift(points: np.ndarray, arm, leg) -> np.ndarray:
-        line = eye_z + np.interp(around(points, centre), HAIRLINE_DEG, HAIRLINE_M)
-        rise = np.clip((points[:, 2] - line) / CAP_TUCK_M, 0, 1)
+        rise = np.clip(above(points) / CAP_TUCK_M, 0, 1)
         return CAP_RIM_M + (ease - CAP_RIM_M) * rise * rise * (3 - 2 * rise)
 
     mesh = cut(body, faces, hairline_mask(body), lift, relax=8)
-    return bound(body, cap_uvs(mesh, centre), faces)
+    capped = cap_uvs(mesh, centre)
+    if soft > 0:  # by the distance to the cap's rim: the hairline and round the ears
+        from scipy.spatial import cKDTree
+
+        rim = mesh.vertices[np.unique(boundary_edges(mesh.faces)[0])].astype(np.float64)
+        corners = mesh.vertices[mesh.faces].reshape(-1, 3).astype(np.float64)
+        rise = np.clip(cKDTree(rim).query(corners)[0] / soft, 0, 1)
+        assert capped.uvs is not None  # ``cap_uvs`` gives every corner one
+        uv = capped.uvs.copy()
+        uv[:, 1] = 0.5 + (uv[:, 1] - 0.5) * np.sqrt(rise)
+        capped = per_corner(mesh, uv)
+    return bound(body, capped, faces)
 
 
 CROWN_OFFSET = (0.0, 0.035, 0.1)  # the crown (whorl) from the skull centre at eye height (m)
@@ -210,6 +227,8 @@ def grow_cards(
     segments: int = 2,
     seed: int = 0,
     root: float = 0.0,
+    side_lift: float = 0.0,
+    thin: float = 0.0,
 ) -> Piece:
     """Hair cards rooted inside the hairline, lying along a flow field above the scalp.
 
@@ -230,11 +249,19 @@ def grow_cards(
     card then never rises below it. A buzz cut's cards lie over the cap all their length:
     rooted on the skin they came up through the cap half-way along, and each card's cut
     through it drew the outline of a scale.
+
+    ``side_lift``: m the cards rise further over the temples and ears (``side_volume``),
+    reached half-way along them: long hair's volume at the sides.
+    ``thin``: m above the hairline over which the cards thin out (a root kept with the
+    probability of its height over it there): a buzz cut's soft hairline.
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
     roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
     depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
+    if thin > 0:
+        kept = rng.uniform(size=count) < np.clip(depth / thin, 0.1, 1)
+        roots, depth, count = roots[kept], depth[kept], int(kept.sum())
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
     # Hair lies flat at the crown, where it parts round the whorl.
     crown = centre + np.asarray(CROWN_OFFSET)
@@ -252,8 +279,9 @@ def grow_cards(
         step = _tangent(body, point, flow(point, centre, eye_z))
         # Rising evenly along the card (lying down from the root), not steeply at first:
         # a card whose first half rose at 15-25 degrees stood up from the scalp.
-        point = _above_skin(body, point + step * (size / segments)[:, None],
-                            start + (top - start) * (k / segments))  # fmt: skip
+        point = point + step * (size / segments)[:, None]
+        volume = side_lift * side_volume(point, centre, eye_z) * min(1.0, 2 * k / segments)
+        point = _above_skin(body, point, start + (top - start) * (k / segments) + volume)
         rows.append(point)
     path = np.stack(rows, 1)  # (N, K+1, 3)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
@@ -313,6 +341,27 @@ def _strands(path: np.ndarray, normal: np.ndarray, width: float, rng
     return strands, np.cos(turn) * facing + np.sin(turn) * side
 
 
+SIDE_VOLUME_DEG = (45, 65, 115, 135)  # round the head: from the temples to behind the ears
+# m above the eyes: no lift below the first, full from the second to the third (above the
+# ears and over the temples), none above the fourth (the crown). Lifted down over the ear
+# itself too, a card's vertex bound there came 6.3 mm inside a child's ear.
+SIDE_VOLUME_Z = (-0.03, 0.0, 0.035, 0.075)
+
+
+def side_volume(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+    """(N,) 0..1 where hair stands out from the head at the sides (points (N, 3)): above
+    the ears and over the temples (``SIDE_VOLUME_DEG`` round the head, ``SIDE_VOLUME_Z``
+    above the eyes, easing in and out: not down on the shoulders, nor on the crown)."""
+    turn = around(points, centre)
+    a, b, c, d = SIDE_VOLUME_DEG
+    round_ = np.clip((turn - a) / (b - a), 0, 1) * np.clip((d - turn) / (d - c), 0, 1)
+    z = points[:, 2] - eye_z
+    low, full, fading, high = SIDE_VOLUME_Z
+    up = np.clip((z - low) / (full - low), 0, 1) * np.clip((high - z) / (high - fading), 0, 1)
+    w = round_ * up
+    return w * w * (3 - 2 * w)
+
+
 def _shorten(path: np.ndarray, fraction: np.ndarray) -> np.ndarray:
     """(N, K, 3) paths resampled evenly (by sample index) over their first ``fraction``
     (N,) of their samples."""
@@ -339,6 +388,7 @@ def cards_on(
     strip: float = 0.12,
     clump: int = 0,
     stand: float = 0.0,
+    taper: float = 0.7,
 ) -> Piece:
     """Short strand cards rooted on the chosen skin faces (``keep``, (F,) bool over
     ``body.skin_faces``), lying along ``flow`` (points (N, 3) -> directions (N, 3)) and
@@ -359,7 +409,8 @@ def cards_on(
     about that many cards, each of its own length (70-130 %), whose tips are drawn
     together (``CLUMP_PULL``): locks with skin-dark gaps between their tips, as a beard's
     hair grows, instead of one even pile of cards. stand: how much a card's lift follows
-    its length (``reach``): 0 none, 1 a card twice as long stands twice as far out."""
+    its length (``reach``): 0 none, 1 a card twice as long stands twice as far out.
+    taper: a card's width at its tip over its width at the root."""
     rng = np.random.default_rng([seed, count])
     roots = _scatter(body, keep, 3 * count, rng)
     grow = np.ones(len(roots)) if density is None else np.asarray(density(roots), float)
@@ -389,8 +440,8 @@ def cards_on(
     # not together), so each clump reads as a lock against the next.
     u0 = None if group is None else (rng.uniform(0, 1, group.max() + 1)[group]
                                      + rng.uniform(0, 2 * strip, count))  # fmt: skip
-    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], strip=strip,
-                       u0=u0)  # fmt: skip
+    return _card_piece(body, path, normal, width, rng, body.skin_faces[keep], taper=taper,
+                       strip=strip, u0=u0)  # fmt: skip
 
 
 CLUMP_PULL = 0.8  # how far a clumped card's tip moves towards its clump's mean tip
@@ -540,6 +591,7 @@ def long_cards(
     layers=(0.004, 0.024),
     seed: int = 1,
     samples: int = 10,
+    side_lift: float = 0.0,
 ) -> Piece:
     """Long hair: strand cards interpolated between neighbouring guide curves (``guides``),
     stacked at random heights between ``layers`` (m) off the guides, of random length.
@@ -550,6 +602,8 @@ def long_cards(
     flat on one surface, read as one flat sheet of painted strands).
     Neighbours are only blended around the back and sides: never across the face.
     UVs: a random column strip of the strand half of the hair texture, roots at v = 0.5.
+    ``side_lift``: m the locks stand at least off the head over the temples and ears
+    (``side_volume``; the crown keeps them on the scalp).
     """
     rng = np.random.default_rng([seed, count])
     # Samples closer together over the head, where the guides bend over the skull.
@@ -575,6 +629,12 @@ def long_cards(
     # Over the head each lock at its own height, up to 2 mm apart: laid at one height on
     # the scalp, the locks met there in one surface and shaded one another black.
     height = height + rng.uniform(0, 0.002, count)[:, None, None] * (1 - below)
+    # Volume over the temples and ears: lying there on the skull, long hair looked
+    # painted on from the side.
+    centre, _ = head_frame(body)
+    volume = side_lift * side_volume(path.reshape(-1, 3), centre, eye_z).reshape(path.shape[:2])
+    vary = np.random.default_rng([seed, count, 11]).uniform(0.7, 1.0, count)  # (own stream)
+    height = np.maximum(height, volume[..., None] * vary[:, None, None])
     flat = path.reshape(-1, 3)
     normal = body.outward(flat).reshape(path.shape)
     path = path + height * normal
@@ -754,8 +814,12 @@ def hang_cards(
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
     path = _fall_clear(_no_lone_locks(path, centre, eye_z + 0.03), centre, eye_z + 0.03)
+    # Drawn in under the ears on a path three times as fine (a straight 3.5 cm segment
+    # from above the ear to a point drawn in below it cut in across the ear's level).
+    fine = _finer(path, 3)
+    fine = _hang_in(body, fine, centre, eye_z - 0.055)
     stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
-    path = _curl_in(body, _cut_at(path, stop), centre)
+    path = _curl_in(body, _cut_at(fine, stop)[:, ::3], centre)
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
@@ -777,6 +841,42 @@ def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarra
     out = path.copy()
     out[..., :2] = centre[:2] + rel * scale[..., None]
     return out
+
+
+def _finer(path: np.ndarray, times: int) -> np.ndarray:
+    """(N, (K - 1) * times + 1, 3) the paths (N, K, 3) with ``times - 1`` points put evenly
+    between each pair of their points (the same polylines)."""
+    t = np.linspace(0, path.shape[1] - 1, (path.shape[1] - 1) * times + 1)
+    j = np.minimum(t.astype(int), path.shape[1] - 2)
+    f = (t - j)[None, :, None]
+    return path[:, j] * (1 - f) + path[:, j + 1] * f
+
+
+HANG_GAP_M = 0.012  # hanging hair below the ears: at most this far off the neck and jaw
+HANG_PULL_M = 0.045  # ... reached over this drop below the ears
+
+
+def _hang_in(body: AuthoringBody, path: np.ndarray, centre: np.ndarray,
+             below: float) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) hanging paths drawn in towards the head's vertical axis (through
+    ``centre``) below the height ``below`` (under the ears), behind the cheeks, until they
+    hang at most ``HANG_GAP_M`` off the skin, reached gradually over ``HANG_PULL_M`` of
+    drop: hair falls past the ears and then in against the neck and jaw under its weight.
+    (Falling straight down from the ears' width, a bob's side locks hung 3.5 cm off the
+    neck and stood out from it seen from behind.) Kept 3 mm off the skin."""
+    out = path.reshape(-1, 3).copy()
+    drop = np.clip((below - out[:, 2]) / HANG_PULL_M, 0, 1)
+    side = np.clip((around(out, centre) - 50) / 30, 0, 1)  # not over the cheeks
+    weight = (drop * drop * (3 - 2 * drop)) * side
+    moved = weight > 0
+    for _ in range(3):  # the skin is not straight in: step in, measure again
+        gap, _ = body.skin_tree.query(out)
+        shift = np.maximum(gap - HANG_GAP_M, 0) * weight
+        rel = out[:, :2] - centre[:2]
+        radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+        out[:, :2] = centre[:2] + rel * (np.maximum(radius - shift, 0) / radius)[:, None]
+        out[moved] = _off_skin(body, out[moved], 0.003)
+    return out.reshape(path.shape)
 
 
 def _no_lone_locks(path: np.ndarray, centre: np.ndarray, below: float,

@@ -44,6 +44,7 @@ STUBBLE_BACK_M = 0.01  # u's angle is measured about the skull centre moved this
 # make up GREY_MOST of the hair at age 1.
 GREY_FROM, GREY_MOST = 0.6, 0.9
 GREY_RGB = np.array([0.62, 0.61, 0.58], np.float32)  # linear: white-grey hair
+GREY_LIGHTS = (0.35, 2.3)  # grey strands lighter than the median: shade ** 0.35, at most 2.3
 
 
 def _soft(x: np.ndarray) -> np.ndarray:
@@ -89,41 +90,70 @@ def beard_material(spec, size: int = 1024) -> Material:
     """A beard's or moustache's cut-out strand material in the spec's hair colour (the
     scalp hair's, ``textures.hair_material``).
 
-    Strand cards (v in [0, 0.5]) thinned: beard hair is coarse and sparse, so only about
-    two hair-wide columns in five are kept, and the kept strands end raggedly (each tip at
-    its own length, a fine taper instead of a cut) so the outline breaks up into hairs (a
-    card of scalp strands would read as a solid block on the face).
+    Strand cards (v in [0, 0.5]) thinned into single hairs (``card_cover``), about as
+    light from root to tip (``_even_cards``): a card of scalp strands would read as a
+    solid block on the face, and scalp hair's roots-dark, tips-light shading drew each
+    clump of a short beard as a scale with a light rim over the next one's dark roots.
     The dense rows (v in [0.5, 1]) are the undercoat under a beard's cards: short hairs
     along v, covering more of the skin the higher v is (``UNDERCOAT_V``)."""
     m = textures.hair_material(spec, size)
     colour = np.array(m.base_color_texture, copy=True)
     rng = np.random.default_rng([size, 17])
-    hair = max(size // 340, 1)  # texels per hair across (a card's ~0.1 mm at 1024 px)
-    kept = np.repeat(rng.uniform(size=size // hair + 1) < 0.4, hair)[:size]
+    hair = max(size // 340, 1)  # texels per hair across (a card's ~0.12 mm at 1024 px)
     half = size // 2
     cards = slice(size - half, size)  # rows of the strand-card half (v in [0, 0.5])
-    # Ragged tips: every hair column ends at its own length (60..100 % of the card) over a
-    # soft taper, and the strand gap texels next to kept ones are half-covered (fine hairs).
-    length = np.repeat(rng.uniform(0.6, 1.0, size // hair + 1), hair)[:size]
-    t = (np.arange(half) + 0.5) / half  # roots (0) to tips (1) down the card half
-    tip = np.clip((length[None, :] - t[:, None]) / 0.25, 0, 1)
-    fine = np.convolve(kept.astype(np.float32), np.ones(3) / 3, "same") * 0.35
-    cover = np.maximum(kept.astype(np.float32), fine)[None, :] * tip
-    colour[cards, :, 3] = np.round(colour[cards, :, 3] * cover).astype(np.uint8)
+    colour[cards, :, :3] = _even_cards(colour[cards, :, :3])
+    colour[cards, :, 3] = np.round(colour[cards, :, 3] * card_cover(half, size, hair, rng))
     colour[: size - half, :, 3] = undercoat_alpha(size - half, size, hair, rng)
     # The undercoat is the hair deep in the beard, in the shade of the clumps over it:
     # as light as the cards, the gaps between clumps did not show and the beard read as
     # one even mat.
     under = colour[: size - half, :, :3].astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
-    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY}
+    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY, "sheen": BEARD_SHEEN}
     return replace(m, base_color_texture=colour, extras=extras)
+
+
+def card_cover(rows: int, size: int, hair: int, rng) -> np.ndarray:
+    """(rows, size) float32 coverage (0..1) of a beard's strand-card rows (row 0 the
+    roots): single hairs ``hair`` texels wide, about one hair column in three kept and never
+    two side by side (kept neighbours merged into flat ribbons a few hairs wide, read as
+    flakes), each ending at its own length (55..100 % of the card) and tapering to one
+    texel over its last third (a fine tip instead of a blunt cut)."""
+    cols = size // hair + 1
+    pick = rng.uniform(size=cols) < 0.5
+    for i in range(1, cols):  # no two neighbours: a hair, then at least one gap
+        pick[i] &= not pick[i - 1]
+    kept = np.repeat(pick, hair)[:size].astype(np.float32)
+    length = np.repeat(rng.uniform(0.55, 1.0, cols), hair)[:size]
+    middle = np.tile(np.arange(hair) == hair // 2, cols)[:size]  # a hair's central texel
+    t = (np.arange(rows) + 0.5) / rows  # roots (0) to tips (1) down the card half
+    ends = np.where(middle, length, length * 0.67)  # a hair's sides stop short of its tip
+    tip = np.clip((ends[None, :] - t[:, None]) / 0.06, 0, 1)
+    return (kept[None, :] * tip).astype(np.float32)
+
+
+def _even_cards(rgb: np.ndarray) -> np.ndarray:
+    """(rows, W, 3) uint8 sRGB of a hair texture's strand-card rows with the scalp
+    layout's lightening from root to tip (``textures.strand_shade``) evened out to a
+    tenth: each strand keeps its own shade."""
+    rows = rgb.shape[0]
+    t = (np.arange(rows) + 0.5) / rows
+    along = 0.6 + 0.65 * t**0.8  # ``textures.strand_shade``'s card rows
+    even = (0.95 + 0.1 * t) / along
+    lin = _linear(rgb) * even[:, None, None]
+    return fabrics.srgb(np.clip(lin, 0, 1))
 
 
 # Light a beard's cards pass through (the renderer's hint, ``blender.materials``): they lie
 # on the skin, one layer over the undercoat, so little; at scalp hair's 0.6 a grey beard's
-# clumps lit from behind by the key light glowed white, flakes of cotton wool.
-BEARD_TRANSLUCENCY = 0.15
+# clumps lit from behind by the key light glowed white, flakes of cotton wool. (A share of
+# the light since the Translucent BSDF is mixed in, not added: scalp hair's is 0.3.)
+BEARD_TRANSLUCENCY = 0.1
+# The fibre rim (Principled sheen) on a beard's cards: at scalp hair's 0.25 a clump lying
+# at a grazing angle to the camera (under the lip, on the chin) lit up as a whole, a grey
+# flake on a dark beard.
+BEARD_SHEEN = 0.05
 
 
 def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
@@ -259,8 +289,12 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         else:
             grey = rng.uniform(size=size) < share
         white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey
-        # Grey strands keep the card's strand shading (a flat grey reads as paint).
-        white = white[None, None, :] * _strand_shade(tex, kind)[..., None]
+        # Grey strands keep the card's strand shading (a flat grey reads as paint), its
+        # lights compressed (``GREY_LIGHTS``): a beard's cards, 2.4 times as light as its
+        # undercoat, went to pure white, cotton wool.
+        shade = _strand_shade(tex, kind)
+        light = np.minimum(shade, GREY_LIGHTS[1]) ** GREY_LIGHTS[0]
+        white = white[None, None, :] * np.where(shade > 1, light, shade)[..., None]
         lin = np.where(grey[..., None], white, lin)
     alpha = tex[..., 3]
     if kind == "brows" and age < 0.3:  # a child's brows: fine, fair, faint

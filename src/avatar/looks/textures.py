@@ -228,3 +228,43 @@ def hair_material(spec, size: int = 1024) -> Material:
     # Hair is a fibre, not a mirror: a weaker specular keeps dark hair from glaring white.
     extras = {**m.extras, "specular": 0.3}
     return replace(m, base_color_texture=colour, alpha_mode=mode, extras=extras)
+
+
+# A buzz cut's scalp layer (the dense half of its texture, ``buzz_material``): stubble,
+# not a cap. A share BUZZ_COVER of its short hairs is kept (the scalp shows between them
+# up close), thinning out to BUZZ_EDGE_COVER at v = 0.5, where ``clothes.hair.base_cap``
+# maps the hairline (a soft hairline, hair by hair, instead of an edge), over BUZZ_EDGE_V.
+BUZZ_COVER = 0.6
+BUZZ_EDGE_COVER = 0.08
+BUZZ_EDGE_V = 0.1
+BUZZ_CARD_KEEP = 0.7  # share of a buzz card's strand columns kept (scalp between them)
+BUZZ_BUMP = 1.5  # the normal map's depth of a stubble hair (``fabrics.normal_map``)
+
+
+def buzz_material(spec, size: int = 1024) -> Material:
+    """A buzz cut's Material: ``hair_material`` with its dense half made stubble (short
+    hairs, ``BUZZ_COVER`` of them, fewer towards the hairline's v = 0.5, each raised in
+    the normal map as a short bump of its own height, so light catches hairs rather than
+    one combed surface) and its cards thinned (``BUZZ_CARD_KEEP``)."""
+    m = hair_material(spec, size)
+    colour = np.array(m.base_color_texture, copy=True)
+    normal = np.array(m.normal_texture, copy=True)
+    half = size // 2
+    rng = np.random.default_rng([size, 41])
+    seg = max(int(round(size * DENSE_HAIR_ROWS)), 1)  # as ``dense_hairs``
+    rows = np.arange(half)[:, None] + rng.integers(0, seg, size)[None, :]
+    hairs = (rows // seg) * size + np.arange(size)[None, :]
+    v = 1 - (np.arange(half) + 0.5) / size  # row 0 at v = 1, down to 0.5
+    edge = np.clip((v - 0.5) / BUZZ_EDGE_V, 0, 1)
+    share = BUZZ_EDGE_COVER + (BUZZ_COVER - BUZZ_EDGE_COVER) * edge * edge * (3 - 2 * edge)
+    rank = rng.uniform(size=hairs.max() + 1)[hairs]
+    kept = rank < share[:, None]
+    colour[:half, :, 3] = np.where(kept, 255, 0).astype(np.uint8)
+    # Each hair a bump (its own height, rounded along its length) on the scalp.
+    along = rows % seg
+    bump = np.sin(np.pi * (along + 0.5) / seg) * rng.uniform(0.5, 1.0, hairs.max() + 1)[hairs]
+    height = np.where(kept, bump, 0.0).astype(np.float32)
+    normal[:half] = fabrics.normal_map(height, BUZZ_BUMP)
+    keep = (rng.uniform(size=size) < BUZZ_CARD_KEEP)[None, :]
+    colour[half:, :, 3] = np.where(keep, colour[half:, :, 3], 0).astype(np.uint8)
+    return replace(m, base_color_texture=colour, normal_texture=normal)
