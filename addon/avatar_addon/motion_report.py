@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+LABEL_SHARE = 0.34  # of a row for its label (avatar.motion.report_card.LABEL_SHARE)
+
 
 def rows(root) -> list[tuple[str, str, bool]]:
     """(label, value, alert) rows of the last motion's report on ``root``: its numbers

@@ -665,9 +665,9 @@ def _draw_clip(layout, settings):
 def _draw_mapping(layout, settings, root):
     box = layout.box()
     icon = "TRIA_DOWN" if settings.show_mapping else "TRIA_RIGHT"
-    row = box.row(align=True)
-    row.prop(settings, "show_mapping", icon=icon, emboss=False)
-    row.label(text="edited" if settings.custom_map else "automatic")
+    # One label: split in two, the row cut "Bone mapping" to "Bone m..." at the default width.
+    state = "edited" if settings.custom_map else "automatic"
+    box.prop(settings, "show_mapping", text=f"Bone mapping: {state}", icon=icon, emboss=False)
     if not settings.show_mapping:
         return
     row = box.row(align=True)
@@ -694,11 +694,15 @@ def _draw_report(layout, root):
     if not rows:
         return
     box = layout.box()
-    box.label(text="Retarget quality", icon="INFO")
+    alerts = sum(alert for _, _, alert in rows)
+    box.label(text=f"Retarget quality: {alerts} to check" if alerts else "Retarget quality",
+              icon="ERROR" if alerts else "CHECKMARK")  # fmt: skip
     column = box.column(align=True)
     for label, value, alert in rows:
-        split = column.split(factor=0.34)  # report_card's labels: 10 characters at most
-        split.label(text=label, icon="ERROR" if alert else "CHECKMARK")
+        # No icon per row: at the sidebar's default width it cut the labels to two letters.
+        split = column.split(factor=motion_report.LABEL_SHARE)
+        split.alert = alert  # drawn red
+        split.label(text=label)
         split.label(text=value)
 
 

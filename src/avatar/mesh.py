@@ -71,6 +71,16 @@ def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return n
 
 
+def face_edges(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(K, 2) every edge of faces (F, N), each as its sorted vertex pair (an edge two faces
+    share appears twice), and (K,) the face each belongs to. The zero-length edge of a
+    padded triangle (a quad repeating its last corner) is dropped."""
+    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
+    owner = np.repeat(np.arange(len(faces)), faces.shape[1])
+    real = edges[:, 0] != edges[:, 1]
+    return edges[real], owner[real]
+
+
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(V, 3) float32 unit vertex normals, area-weighted over adjacent faces."""
     fn = face_normals(vertices, faces)

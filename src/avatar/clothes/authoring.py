@@ -22,7 +22,7 @@ from avatar.clothes.binding import Binding, axis_scale, make_binding
 from avatar.geometry.shell import boundary_edges
 from avatar.looks.fabrics import TILE_METRES
 from avatar.looks.tailored import Layout
-from avatar.mesh import Mesh, vertex_normals
+from avatar.mesh import Mesh, face_edges, face_normals, vertex_normals
 
 
 class AuthoringBody:
@@ -140,6 +140,7 @@ def _eased(points: np.ndarray, faces: np.ndarray, normals: np.ndarray, ease: np.
         moves = ease[:, None] * normals
         out = points + (on_their_side(points, moves) if sided else moves)
         n = face_normals(out, faces)
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
         folded = np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
         if not folded.any():
             break
@@ -158,21 +159,11 @@ def _eased(points: np.ndarray, faces: np.ndarray, normals: np.ndarray, ease: np.
 
 def face_pairs(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(P,), (P,) the two faces of every edge two faces (F, C) share."""
-    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
-    owner = np.repeat(np.arange(len(faces)), faces.shape[1])
-    real = edges[:, 0] != edges[:, 1]
-    edges, owner = edges[real], owner[real]
+    edges, owner = face_edges(faces)
     order = np.lexsort(edges.T[::-1])
     edges, owner = edges[order], owner[order]
     shared = np.all(edges[1:] == edges[:-1], axis=1)
     return owner[:-1][shared], owner[1:][shared]
-
-
-def face_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(F, 3) unit normals of quads or padded triangles (F, 4) (from the diagonals)."""
-    q = v[faces]
-    n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
-    return n / np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
 
 
 MIDPLANE = 1e-5  # m: a vertex this close to x = 0 lies on the body's plane of symmetry
@@ -583,11 +574,7 @@ def _band_runs(faces: np.ndarray, band: np.ndarray, v: np.ndarray, edges: np.nda
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    f = faces[band]
-    pairs = np.sort(np.stack([f, np.roll(f, -1, axis=1)], -1).reshape(-1, 2), axis=1)
-    owner = np.repeat(np.arange(len(band)), f.shape[1])
-    real = pairs[:, 0] != pairs[:, 1]
-    pairs, owner = pairs[real], owner[real]
+    pairs, owner = face_edges(faces[band])
     _, key, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
     key = key.ravel()
     order = np.argsort(key, kind="stable")

@@ -15,7 +15,7 @@ from scipy.sparse import csr_matrix
 
 from avatar.clothes.binding import Binding
 from avatar.io.mhw import BoneWeights
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, face_edges
 from avatar.rig.skinning import SkinWeights
 
 MIN_WEIGHT = 1e-4  # MakeHuman's threshold
@@ -128,9 +128,7 @@ def swing(
 def _neighbour_mean(mesh: Mesh, rows: np.ndarray) -> csr_matrix:
     """(R, N) sparse: for each vertex of ``rows`` (N,) bool, the mean over its mesh
     neighbours (an isolated vertex keeps its own value)."""
-    faces = mesh.faces
-    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
-    edges = np.unique(edges[edges[:, 0] != edges[:, 1]], axis=0)
+    edges = np.unique(face_edges(mesh.faces)[0], axis=0)
     n = len(mesh.vertices)
     a = np.concatenate([edges[:, 0], edges[:, 1], np.arange(n)])
     b = np.concatenate([edges[:, 1], edges[:, 0], np.arange(n)])

@@ -58,44 +58,55 @@ def card(report: RetargetReport) -> dict:
     return out
 
 
-LABEL_CHARS = 10  # what the sidebar's label column shows at its default width
-VALUE_CHARS = 24  # and its value column: longer text is cut off with an ellipsis
+# Blender's sidebar at its default width (Blender 3.4-5.0, UI scale 1, measured on the real
+# window's screenshot, tests/ui): the report box's rows are split at LABEL_SHARE; its label
+# column shows LABEL_PX of text and its value column VALUE_PX, in the UI font at 11 pt.
+# Wider text is cut off with an ellipsis (with labels of 10 characters and an icon each,
+# they were cut to two: "So...", "Di..."), so labels are short words, rows carry no icon
+# (an alert row is drawn red) and numbers are formatted to fit
+# (tests/blender/test_motion_panel.py measures the worst case with blf).
+LABEL_SHARE = 0.34
+LABEL_PX = 46
+VALUE_PX = 100  # "30 frames, 120 fps" (100 px) showed whole; 102 px was cut
+NAMED = ("Source", "Worst", "Stretch")  # values that are names: a long one may be cut
 
 
 def lines(data: dict) -> list[tuple[str, str, bool]]:
-    """(label, value, alert) rows of a ``card`` for display, in reading order: labels of at
-    most ``LABEL_CHARS`` and values of at most ``VALUE_CHARS`` characters, so that nothing
-    is cut off in Blender's sidebar at its default width."""
-    rows = [("Clip", f"{data.get('frames', 0)} frames, {data.get('fps', 0):.0f} fps", False),
+    """(label, value, alert) rows of a ``card`` for display, in reading order, short enough
+    for Blender's sidebar at its default width (``LABEL_PX``, ``VALUE_PX``)."""
+    rows = [("Clip", f"{data.get('frames', 0)} at {data.get('fps', 0):.0f} fps", False),
             ("Source", str(data.get("source", "?")), False),
-            ("Mapping", f"{data.get('mapped', 0)} bones, scale {data.get('scale', 1.0):.2f}",
-             False)]  # fmt: skip
+            ("Bones", f"{data.get('mapped', 0)}, scale {data.get('scale', 1.0):.2f}", False)]
     if "direction_median" in data:
         p95 = data["direction_p95"]
-        rows.append(("Direction", f"{data['direction_median']:.1f}\u00b0 (p95 {p95:.1f}\u00b0)",
+        rows.append(("Error", f"{_deg(data['direction_median'])} (p95 {_deg(p95)})",
                      p95 > DIRECTION_ALERT_DEG))  # fmt: skip
         if data.get("worst_bone"):
-            rows.append(("Worst bone", f"{data['worst_bone']} {data['worst_deg']:.0f}\u00b0",
+            rows.append(("Worst", f"{data['worst_bone']} {data['worst_deg']:.0f}\u00b0",
                          data["worst_deg"] > DIRECTION_ALERT_DEG))  # fmt: skip
-        rows.append(("Skating", f"{data['skating_cm']:.2f} cm/frame "
-                     f"({data['contact_frames']})", data["skating_cm"] > SKATING_ALERT_CM))
+        rows.append(("Skating", f"{_num(data['skating_cm'])} cm/frame",
+                     data["skating_cm"] > SKATING_ALERT_CM))  # fmt: skip
         bent = data["limit_violations"]
-        rows.append(("Limits", f"{bent} frames bent back" if bent else "none bent back",
-                     bent > 0))  # fmt: skip
+        rows.append(("Limits", f"{bent} bent back" if bent else "none bent back", bent > 0))
     if "floor_penetration_cm" in data:
-        rows.append(("Floor", f"{data['floor_penetration_cm']:.2f} cm below, "
+        rows.append(("Floor", f"{_num(data['floor_penetration_cm'])} cm in "
                      f"{data['floor_penetrating'] * 100:.0f}%",
                      data["floor_penetration_cm"] > FLOOR_ALERT_CM))  # fmt: skip
-        rows.append(("Hover", f"{data['hover_cm']:.2f} cm, max {data['hover_max_cm']:.2f}",
+        rows.append(("Hover", f"{_num(data['hover_cm'])} cm, max {_num(data['hover_max_cm'])}",
                      data["hover_cm"] > HOVER_ALERT_CM))  # fmt: skip
     elif "feet_below_cm" in data:
-        rows.append(("Floor", f"feet {data['feet_below_cm']:.2f} cm below",
+        rows.append(("Floor", f"feet {_num(data['feet_below_cm'])} cm below",
                      data["feet_below_cm"] > FLOOR_ALERT_CM))  # fmt: skip
     if data.get("deformed"):
         more = len(data["deformed"]) - 1
         rows.append(("Stretch", data["deformed"][0] + (f" +{more}" if more else ""), True))
-    return [(label, _fit(value), alert) for label, value, alert in rows]
+    return rows
 
 
-def _fit(value: str) -> str:
-    return value if len(value) <= VALUE_CHARS else value[: VALUE_CHARS - 1] + "\u2026"
+def _num(x: float) -> str:
+    """A measure in as many digits as fit: 0.12, 12.3, 123."""
+    return f"{x:.2f}" if abs(x) < 10 else f"{x:.1f}" if abs(x) < 100 else f"{x:.0f}"
+
+
+def _deg(x: float) -> str:
+    return (f"{x:.1f}" if abs(x) < 10 else f"{x:.0f}") + "\u00b0"
