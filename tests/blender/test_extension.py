@@ -432,3 +432,37 @@ def test_a_garment_far_from_the_body_is_refused(character_and_vest, tmp_path):
     with pytest.raises(RuntimeError, match="from the body"):
         bpy.ops.avatar.bind_garment(name="vest", folder=str(folder))
     assert not folder.exists()
+
+
+def test_the_dress_grid_swaps_swatches_for_pictures_drawn_outside_blender(installed):
+    """A built-in with no cached picture shows its swatch at once; a separate Python process
+    draws the picture (``python -m avatar.clothes.thumbnail``) and the grid's timer swaps
+    it in; unregistering stops the process."""
+    import importlib
+    import time
+
+    from avatar.clothes import thumbnail
+    from extension_fixtures import ADDON
+
+    thumbnails = importlib.import_module(f"{ADDON}.thumbnails")
+    thumbnails.release()
+    picture = thumbnail.picture_path("tshirt")
+    picture.unlink(missing_ok=True)
+    try:
+        thumbnails.icon("tshirt", "")  # (icon ids are 0 headless: no GPU to draw them)
+        assert "tshirt" in thumbnails._DRESS.get()  # the swatch, at once
+        assert "tshirt" in thumbnails._SWATCHED and len(thumbnails._DRAWER) == 1
+        deadline = time.monotonic() + 300
+        while not picture.is_file() and thumbnails._DRAWER[0].poll() is None:
+            assert time.monotonic() < deadline, "no picture drawn in 5 minutes"
+            time.sleep(0.5)
+        assert picture.is_file(), f"drawer exited {thumbnails._DRAWER[0].returncode}"
+        thumbnails._swap_pictures()  # what the timer does (timers do not run headless)
+        assert "tshirt" not in thumbnails._SWATCHED
+        assert "tshirt" not in thumbnails._DRESS.get()  # reloaded on the next draw...
+        thumbnails.icon("tshirt", "")
+        assert "tshirt" in thumbnails._DRESS.get() and "tshirt" not in thumbnails._SWATCHED
+        process = thumbnails._DRAWER[0]
+    finally:
+        thumbnails.release()
+    assert process.wait(timeout=30) is not None and not thumbnails._DRAWER

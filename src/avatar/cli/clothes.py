@@ -36,6 +36,20 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--z-depth", type=int, default=50, help="layer: higher goes over lower")
     p.add_argument("--texture", metavar="IMAGE", help="diffuse texture to copy beside it")
     p.set_defaults(run=run_bind)
+    p = clothes_sub.add_parser(
+        "thumbnails", help="draw library items' pictures (PNG), as the Blender grid shows them",
+        description="Draw each item as worn by the default body, from the front (shoes in "
+        "profile), in its colours, as a PNG with a transparent background.")  # fmt: skip
+    p.add_argument("names", nargs="*", metavar="NAME", help="items (default: every built-in)")
+    p.add_argument("--out", metavar="DIR",
+                   help="folder to write NAME.png into (default: Avatar's cache, named as the "
+                   "Blender extension looks for them)")  # fmt: skip
+    p.add_argument("--size", type=int, default=128, help="pixels square (16-1024)")
+    p.add_argument("--folder", action="append", metavar="DIR",
+                   help="also find items in this MakeHuman/MPFB asset folder; repeatable")
+    p.add_argument("--missing", action="store_true",
+                   help="only the items whose cached picture is missing (without --out)")
+    p.set_defaults(run=run_thumbnails)
 
 
 def run_list(args: argparse.Namespace) -> int:
@@ -56,4 +70,28 @@ def run_bind(args: argparse.Namespace) -> int:
                            frame=args.frame, tags=tuple(args.tag or ()), z_depth=args.z_depth,
                            texture=args.texture)  # fmt: skip
     print(f"wrote {path}: wear it on any body with --wear {path}")
+    return 0
+
+
+def run_thumbnails(args: argparse.Namespace) -> int:
+    """Write one picture per item (``clothes.thumbnail``); every name is checked first, so
+    a bad one writes nothing."""
+    from pathlib import Path
+
+    from avatar.clothes import thumbnail
+    from avatar.errors import ParameterError
+
+    if not 16 <= args.size <= 1024:
+        raise ParameterError(f"--size must be 16-1024 pixels, got {args.size}")
+    names = args.names or [e.name for e in library.builtin_entries()]
+    for name in names:
+        library.entry_of(name, args.folder or ())  # unknown: ParameterError, close matches
+    if args.missing and not args.out:
+        thumbnail.draw_missing(names, args.size)
+        return 0
+    human = Human({})
+    for name in names:
+        path = Path(args.out) / f"{name}.png" if args.out else None
+        written = thumbnail.write_picture(name, args.size, path, human, args.folder or ())
+        print(f"wrote {written}", flush=True)
     return 0

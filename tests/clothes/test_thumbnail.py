@@ -1,0 +1,110 @@
+"""Library pictures (``clothes.thumbnail``): each item drawn as worn, in its own colours and
+cut-outs, framed on itself; what a fabric swatch could not show (sleeves, a shoe's profile)
+is measured on the picture."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar.clothes import thumbnail
+from avatar.human import Human
+
+
+@pytest.fixture(scope="module")
+def human():
+    return Human({})
+
+
+@pytest.fixture(scope="module")
+def pictures(human):
+    names = ("tshirt", "tanktop", "jeans", "skirt", "shoes", "eyelashes")
+    return {name: thumbnail.garment_picture(name, 96, human) for name in names}
+
+
+def _cloth(image: np.ndarray) -> np.ndarray:
+    """The item's own pixels: opaque (the body is a half-transparent ghost)."""
+    return image[..., 3] == 255
+
+
+def _extent(mask: np.ndarray) -> tuple[int, int]:
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    return cols[-1] - cols[0] + 1, rows[-1] - rows[0] + 1
+
+
+def test_pictures_are_rgba_with_a_clear_background_and_a_ghost_body(pictures):
+    for name, image in pictures.items():
+        assert image.shape == (96, 96, 4) and image.dtype == np.uint8, name
+        assert _cloth(image).sum() > 40, name
+    for name in ("tshirt", "jeans", "shoes"):
+        assert (pictures[name][..., 3] == 0).sum() > 500, name  # a clear background
+    ghost = (pictures["tshirt"][..., 3] > 90) & (pictures["tshirt"][..., 3] < 160)
+    assert ghost.sum() > 200  # the neck and arms, half transparent
+
+
+def test_a_tshirt_shows_its_sleeves_and_a_tank_top_none(pictures):
+    wide = [w / h for w, h in map(_extent, (_cloth(pictures[n]) for n in ("tshirt", "tanktop")))]
+    assert wide[0] > 1.25 * wide[1], wide
+
+
+def test_pictures_take_the_items_colours_from_its_textures(pictures):
+    jeans = pictures["jeans"][_cloth(pictures["jeans"])][:, :3].astype(float).mean(axis=0)
+    skirt = pictures["skirt"][_cloth(pictures["skirt"])][:, :3].astype(float).mean(axis=0)
+    assert jeans[2] > 1.3 * jeans[0], jeans  # denim blue
+    assert skirt[0] > 2 * skirt[2], skirt  # red
+
+
+def test_shoes_are_drawn_in_profile(pictures):
+    """One shoe from the side: one run of columns, longer than high (seen from the front
+    the two shoes were two blobs with floor between them)."""
+    mask = _cloth(pictures["shoes"])
+    columns = np.flatnonzero(mask.sum(axis=0) >= 2)
+    assert np.all(np.diff(columns) == 1), columns
+    width, height = _extent(mask)
+    assert width > 1.6 * height, (width, height)
+
+
+def test_alpha_cut_items_show_their_strands_not_their_cards(human, monkeypatch, pictures):
+    cut = _cloth(pictures["eyelashes"]).sum()
+    monkeypatch.setattr(thumbnail, "_cutoff", lambda material: -1.0)
+    cards = _cloth(thumbnail.garment_picture("eyelashes", 96, human)).sum()
+    assert cut < 0.8 * cards, (cut, cards)
+
+
+def test_pictures_are_written_atomically_where_the_extension_looks(tmp_path, monkeypatch, human):
+    monkeypatch.setenv("AVATAR_CACHE", str(tmp_path))
+    (tmp_path / "thumbnails").mkdir()
+    older = tmp_path / "thumbnails" / "cap-32-0123456789ab.png"  # another version's picture
+    older.write_bytes(b"old")
+    path = thumbnail.write_picture("cap", 32, human=human)
+    assert path == thumbnail.picture_path("cap", 32) and path.parent == tmp_path / "thumbnails"
+    from PIL import Image
+
+    with Image.open(path) as image:
+        assert image.size == (32, 32) and image.mode == "RGBA"
+    assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temporary, no old
+
+
+def test_cli_writes_pictures_and_a_bad_name_writes_none(tmp_path, capsys):
+    from avatar import cli
+
+    out = tmp_path / "pictures"
+    assert cli.main(["clothes", "thumbnails", "cap", "sneakers", "--out", str(out),
+                     "--size", "48"]) == 0  # fmt: skip
+    assert sorted(p.name for p in out.iterdir()) == ["cap.png", "sneakers.png"]
+    bad = tmp_path / "bad"
+    assert cli.main(["clothes", "thumbnails", "cap", "sneakrs", "--out", str(bad)]) == 1
+    assert cli.main(["clothes", "thumbnails", "cap", "--size", "4", "--out", str(bad)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "sneakers" in err[-2] and "--size" in err[-1] and len(err) == 2  # one line each
+    assert not bad.exists()
+
+
+def test_missing_draws_only_what_is_not_cached(tmp_path, monkeypatch, capsys):
+    from avatar import cli
+
+    monkeypatch.setenv("AVATAR_CACHE", str(tmp_path))
+    thumbnail.write_picture("cap")
+    assert cli.main(["clothes", "thumbnails", "cap", "socks", "--missing"]) == 0
+    wrote = capsys.readouterr().out
+    assert "socks" in wrote and "cap" not in wrote
