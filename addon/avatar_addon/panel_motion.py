@@ -665,9 +665,9 @@ def _draw_clip(layout, settings):
 def _draw_mapping(layout, settings, root):
     box = layout.box()
     icon = "TRIA_DOWN" if settings.show_mapping else "TRIA_RIGHT"
-    # One label: split in two, the row cut "Bone mapping" to "Bone m..." at the default width.
+    # One label, short enough for the default width (split in two it showed "Bone m...").
     state = "edited" if settings.custom_map else "automatic"
-    box.prop(settings, "show_mapping", text=f"Bone mapping: {state}", icon=icon, emboss=False)
+    box.prop(settings, "show_mapping", text=f"Bone map: {state}", icon=icon, emboss=False)
     if not settings.show_mapping:
         return
     row = box.row(align=True)
