@@ -106,7 +106,8 @@ def _command(draw, folder: Path) -> tuple[list[str], list[Path]]:
     )
     out_dir.mkdir(exist_ok=True)
     pick = st.sampled_from
-    command = draw(pick(["create", "retarget", "poses", "clothes-bind", "clothes-list", "info"]))
+    command = draw(pick(["create", "retarget", "poses", "clothes-bind", "clothes-list",
+                         "clothes-thumbnails", "info"]))  # fmt: skip
     argv: list[str]
     if command == "create":
         argv = ["create"]
@@ -148,6 +149,13 @@ def _command(draw, folder: Path) -> tuple[list[str], list[Path]]:
         if draw(st.booleans()):
             argv += ["--set", draw(st.builds(lambda n, v: f"{n}={v}", _NAMES, _NUMBERS))]
         writes = [outputs.parent / "garment"]
+    elif command == "clothes-thumbnails":
+        names = draw(st.lists(pick(["cap", "socks", "nope", str(folder / "in.mhclo")]),
+                              min_size=1, max_size=2))  # fmt: skip
+        out = draw(pick([outputs.parent / "pictures", folder / "in.bvh" / "pictures"]))
+        argv = ["clothes", "thumbnails", *names, "--out", str(out),
+                "--size", draw(pick(["24", "4", "x", "2000"]))]  # fmt: skip
+        writes = [out]
     elif command == "clothes-list":
         argv = ["clothes", "list", "--folder", str(folder), "--search", draw(_NAMES)]
         writes = []
@@ -187,7 +195,7 @@ def test_bad_arguments_and_files_never_raise_out_of_the_cli(data):
         assert not leftovers, (argv, leftovers)
         if code != 0 and argv[0] == "create":
             assert not any(p.is_file() for p in writes), (argv, err)
-        if code != 0 and argv[:2] == ["clothes", "bind"]:
+        if code != 0 and argv[:2] in (["clothes", "bind"], ["clothes", "thumbnails"]):
             assert not any(p.exists() for p in writes), (argv, err)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
