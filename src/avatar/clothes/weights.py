@@ -23,7 +23,7 @@ MIN_WEIGHT = 1e-4  # MakeHuman's threshold
 # 30 steps spread a bone's switch over ~15 cm, but the hem still followed one leg at the
 # sides and both at the back, and turned 33 degrees where the two met mid-stride; 240 carry
 # the hips' and thighs' weights down to the hem (the calf's pushes are shared smoothly,
-# ``clothes.hems``): the dress's hem turns at most 31 degrees in the walk (26 at rest; 120
+# ``clothes.hems``): the dress's hem turned at most 31 degrees in the walk (26 at rest; 120
 # steps 34, 360 31 but 29 on the skirt, more at the knee). Built once per rig: ~40 ms. And
 # the influences each vertex keeps: with 4 or 6, a fading bone took the legs' share with it
 # where four leg bones weigh alike (the back's midline followed the spine alone, 0.24 more
