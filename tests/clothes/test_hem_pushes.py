@@ -91,15 +91,19 @@ def _turning_degrees(points: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(np.einsum("nd,nd->n", d, np.roll(d, 1, axis=0)), -1, 1)))
 
 
-@pytest.mark.parametrize(("name", "limit"), [("dress", 40), ("skirt", 35)])
+@pytest.mark.parametrize(("name", "limit"), [("dress", 31), ("skirt", 28)])
 def test_a_skirt_hem_bends_as_one_curve_over_the_knees_through_the_walk(name, limit):
     """A skirt's weights came from the body through its binding: they switched from thigh
     to shin within two rows above the knee and from one leg to both at a corner of the
     sides' blend, and the frames' 4-influence cut dropped a 5% shin weight on one hem
     vertex but not the next. Mid-stride the hem folded there (a notch over the knee): the
     dress's hem turned 48 degrees between two neighbouring vertices, the skirt's 39 (26
-    and 30 at rest; now 36 and 31). Its weights ramp from the hips down
-    (``weights.swing``)."""
+    and 30 at rest; 36 and 31 with its weights ramped from the hips down,
+    ``weights.swing``). Then the hem followed one leg at the sides and both at the back,
+    and the calf of the back leg pushed two hem points 4.4 cm out of their row and the
+    next 1.7 cm: a notch at the back. Now the hips' and thighs' weights reach the hem and
+    the calf's push is shared along the cloth, and its rows are rounded in plan below the
+    hips (``clothes.hems``): 28 and 25.5 degrees (21 and 20 at rest)."""
     human = Human({"gender": 0.0, "age": 0.5}).dressed(name)
     fitted = human.outfit.garments[0]
     count = len(fitted.garment.mesh.vertices)

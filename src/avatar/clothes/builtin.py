@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from avatar.clothes import face, hair, headwear, jacket, shoes, tailoring
+from avatar.clothes import face, hair, headwear, hems, jacket, shoes, tailoring
 from avatar.clothes.authoring import (
     AuthoringBody,
     Piece,
@@ -192,6 +192,8 @@ def _skirt(body: AuthoringBody, bottom_z: float, ease, tailor: bool = False,
         points = tailoring.sit_on_hips(body, mesh.vertices, hug, float(body.marks.hip[:, 2].mean()),
                                        under=under, gap=gap, edge_gap=edge_gap)  # fmt: skip
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+    # Below the hips the helper's D-shaped section rounded off (a crease down each side).
+    mesh = hems.rounded_rows(mesh, float(body.marks.hip[:, 2].mean()))
     if not tailor:
         return tailoring.blend_sides(body, bound(body, mesh, faces), "helper-skirt")
     panels = tailoring.Panels(mesh, tailoring.SKIRT_PANELS, tailoring.body_axis(body.marks))

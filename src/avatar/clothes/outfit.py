@@ -17,6 +17,7 @@ from scipy.sparse import csc_matrix, csr_matrix
 
 from avatar.body.model import BODY_VERTICES
 from avatar.clothes.contacts import REMOTE_K, remote_contacts
+from avatar.clothes.hems import HemSpread
 from avatar.geometry import collision
 from avatar.geometry.nearest import PointTree
 from avatar.rig.skinning import SkinWeights, linear_blend
@@ -166,6 +167,7 @@ class _FrameLayout:
     outer_need: np.ndarray
     shell_cloth: _ShellCloth  # the shells' faces, for their normals in a frame
     spread: csc_matrix  # (S, S) a shell point's push shared with its cloth neighbours
+    hem: HemSpread  # and, where a skirt swings, with all its cloth near it
     pair_inner: np.ndarray  # (S,) the remote rows of each shell point's inner and outer layer
     pair_outer: np.ndarray
     remote_order: np.ndarray  # rows of [inner; outer] in output order (inner, outer per garment)
@@ -230,6 +232,9 @@ class _FrameLayout:
             spread=_spread_matrix(
                 [g.garment.mesh.faces + inner_at[k] for k, (_, g, a) in enumerate(hits)
                  if len(a) > 4], shell_rows),  # fmt: skip
+            hem=HemSpread.of(_cat([rests[i] for i, _, a in hits if len(a) > 4], np.float32, 3),
+                             _cat([_swinging(g, len(a[2])) for g, a in shells],
+                                  bool)),  # fmt: skip
             pair_inner=position[shell_rows],
             pair_outer=position[inner_at[-1] + np.arange(len(shell_rows))],
             remote_order=_cat(order, np.intp),
@@ -338,7 +343,8 @@ def _spread_pushes(body: collision.PosedBody, lay: _FrameLayout, points: np.ndar
     out of their rows early in the stride, their neighbours where they were: two faces of
     the cloth turned 56 degrees against each other (a faceted flap at the hem, light or
     dark by its slant; 41 degrees shared)."""
-    take, shared = _shared(lay.spread, pushed[lay.shell] - points[lay.shell])
+    push = pushed[lay.shell] - points[lay.shell]
+    take, shared = _over(_shared(lay.spread, push), lay.hem.shared(push), len(push))
     if len(take) == 0:
         return pushed
     rows = lay.shell[take]
@@ -360,6 +366,26 @@ def _shared(spread: csc_matrix, push: np.ndarray) -> tuple[np.ndarray, np.ndarra
     shared = np.asarray(spread[:, moved] @ push[moved], np.float32)
     take = np.flatnonzero(np.einsum("nd,nd->n", shared, shared) > size + 1e-10)
     return take, shared[take]
+
+
+def _over(a: tuple, b: tuple, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Two sets of shared pushes ((T,) rows, (T, 3) pushes) merged, ``b``'s where a row is
+    in both."""
+    if len(b[0]) == 0:
+        return a
+    push = np.zeros((count, 3), np.float32)
+    push[a[0]] = a[1]
+    push[b[0]] = b[1]
+    take = np.union1d(a[0], b[0])
+    return take, push[take]
+
+
+def _swinging(g: FittedGarment, count: int) -> np.ndarray:
+    """(count,) bool a shell's inner rows that swing (below ``Garment.swing_below``)."""
+    below = g.garment.swing_below
+    if below is None or len(g.garment.mesh.vertices) != count:
+        return np.zeros(count, bool)
+    return g.garment.mesh.vertices[:, 2] < below
 
 
 def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csc_matrix:
