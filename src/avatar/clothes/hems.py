@@ -24,7 +24,7 @@ import numpy as np
 from scipy.sparse import csc_matrix, csr_matrix
 from scipy.spatial import cKDTree
 
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, face_edges
 
 ROUND_PASSES = 12  # Taubin pass pairs along a skirt's rows (a corner spreads ~2 columns each)
 ROUND_FALL = 0.06  # m below the hips over which the rounding comes in (the top hugs the hips)
@@ -107,8 +107,7 @@ def _row_mean(mesh: Mesh) -> tuple[csr_matrix, csr_matrix]:
     (N, N) the difference of those two neighbours (the row's direction there, either way;
     zero at an end)."""
     faces, v = mesh.faces, mesh.vertices.astype(np.float64)
-    edges = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], -1).reshape(-1, 2), axis=1)
-    edges = np.unique(edges[edges[:, 0] != edges[:, 1]], axis=0)
+    edges = np.unique(face_edges(faces)[0], axis=0)
     d = v[edges[:, 1]] - v[edges[:, 0]]
     edges = edges[np.abs(d[:, 2]) < 0.5 * np.hypot(d[:, 0], d[:, 1])]
     n = len(v)
