@@ -298,3 +298,64 @@ def test_long_hair_is_textured_lighter_than_the_roots_inner_layers_most(body):
     tip = verts[:, k - 1]
     gap, _ = body.skin_tree.query(tip)
     assert np.corrcoef(gap, root_v)[0, 1] > 0.3
+
+
+def _edge_points(mesh, per: int = 8) -> np.ndarray:
+    """(M, 3) points along every face edge of ``mesh`` (a card's outline between its
+    vertices, some 4 cm apart along a long lock)."""
+    a = mesh.vertices[mesh.faces].astype(np.float64)
+    b = np.roll(a, -1, axis=1)
+    t = np.linspace(0, 1, per, endpoint=False)[None, None, :, None]
+    return (a[:, :, None] * (1 - t) + b[:, :, None] * t).reshape(-1, 3)
+
+
+def _half_width(points, centre, z) -> float:
+    """m from the head's vertical axis to the outline of ``points`` seen from behind (99th
+    percentile of |x| within 2.5 mm of height z, of those within 4 cm of the ear's plane)."""
+    near = (np.abs(points[:, 2] - z) < 0.0025) & (np.abs(points[:, 1] - centre[1]) < 0.04)
+    return float(np.percentile(np.abs(points[near, 0] - centre[0]), 99))
+
+
+def test_bob_falls_close_to_the_head_over_the_sides(body):
+    """From the parting down to ear level a bob's outline (every layer) stays within 2.2
+    cm of the head's (ears included): lifted up to 2 cm off the skull over the sides as
+    over the crown, it flared out 2.7-3.6 cm there."""
+    centre, eye_z = hair.head_frame(body)
+    points = _edge_points(builtin.BY_NAME["hair-bob"].make(body).mesh)
+    skin = body.vertices.astype(np.float64)
+    for z in eye_z + np.array([0.03, 0.015, 0.0]):
+        head = np.abs(skin[:, 2] - z) < 0.0025
+        head &= np.abs(skin[:, 1] - centre[1]) < 0.04
+        gap = _half_width(points, centre, z) - np.abs(skin[head, 0] - centre[0]).max()
+        assert gap < 0.022, (z - eye_z, gap)
+
+
+def test_buzz_cut_thins_out_at_the_sides_as_at_the_forehead(body):
+    """A buzz cut's cards thin out towards the scalp's rim round the ears and at the
+    sideburns as at the forehead: within 4 mm of the rim, under a third as many cards as
+    in a band as wide 15-19 mm in (0.46 at the sides, thinned only by the height above
+    the hairline: a crisp side hairline)."""
+    centre, _ = hair.head_frame(body)
+    piece = hair.grow_cards(body, hair.flow_crown(sweep=0.0), builtin.BUZZ_CARDS,
+                            (0.005, 0.009), builtin.BUZZ_WIDTH, (0.0024, 0.003), 1,
+                            root=builtin.BUZZ_ROOT, thin=builtin.BUZZ_HAIRLINE_M)  # fmt: skip
+    cards = piece.mesh.vertices.reshape(-1, 4, 3).astype(np.float64)
+    roots = (cards[:, 0] + cards[:, 2]) / 2
+    from_rim = _from_rim(body, roots)
+    turn = hair.around(roots, centre)
+    for where in ((turn > 60) & (turn < 120), turn < 40):
+        near = (where & (from_rim < 0.004)).sum()
+        inside = (where & (from_rim > 0.015) & (from_rim < 0.019)).sum()
+        assert inside > 15 and near < inside / 3, (near, inside)
+
+
+def _from_rim(body, points) -> np.ndarray:
+    """(N,) m from points to the nearest point on the edge of the scalp (``hairline_mask``)."""
+    from scipy.spatial import cKDTree
+
+    from avatar.geometry.shell import boundary_edges
+
+    edges, _ = boundary_edges(body.skin_faces[hair.hairline_mask(body)])
+    t = np.linspace(0, 1, 5, endpoint=False)[None, :, None]
+    a, b = body.vertices[edges[:, 0]][:, None], body.vertices[edges[:, 1]][:, None]
+    return cKDTree((a * (1 - t) + b * t).reshape(-1, 3)).query(points)[0]

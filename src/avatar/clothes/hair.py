@@ -260,7 +260,11 @@ def grow_cards(
     roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
     depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
     if thin > 0:
-        kept = rng.uniform(size=count) < np.clip(depth / thin, 0.1, 1)
+        # By the height above the hairline and the distance to the scalp's rim (round
+        # the ears, the sideburns): by the height alone, the cards ran at full density
+        # up to a crisp line at the sides and temples.
+        inside = np.minimum(depth, rim_distance(body, roots))
+        kept = rng.uniform(size=count) < np.clip(inside / thin, 0.1, 1)
         roots, depth, count = roots[kept], depth[kept], int(kept.sum())
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
     # Hair lies flat at the crown, where it parts round the whorl.
@@ -298,6 +302,18 @@ def grow_cards(
         _card_piece(body, strands, facing, np.full(count, FRINGE_STRAND_M), rng,
                     taper=rng.uniform(0.2, 0.45, count)),
     ])  # fmt: skip
+
+
+def rim_distance(body: AuthoringBody, points: np.ndarray) -> np.ndarray:
+    """(N,) m from ``points`` (N, 3) to the nearest point of the scalp's rim (the edge of
+    ``hairline_mask``: the hairline, round the ears and down the nape)."""
+    from scipy.spatial import cKDTree
+
+    edges, _ = boundary_edges(body.skin_faces[hairline_mask(body)])
+    a, b = body.vertices[edges[:, 0]], body.vertices[edges[:, 1]]
+    t = np.linspace(0, 1, 5, endpoint=False)[None, :, None]  # points along each edge
+    rim = (a[:, None] * (1 - t) + b[:, None] * t).reshape(-1, 3).astype(np.float64)
+    return cKDTree(rim).query(np.asarray(points, np.float64))[0]
 
 
 # Hair falling over the forehead (a fringe, bangs) as strands this wide (m): a card 2.5 cm
@@ -809,7 +825,7 @@ def hang_cards(
         fall = np.clip(k / segments * 2.2, 0, 1)  # combed over the crown, then hanging
         direction = along * (1 - fall)[..., None] + np.array([0, 0, -1.0]) * fall
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
-        gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
+        gap = 0.002 + (_side_lift(point, centre, height) - 0.002) * min(1.0, (k / 3) ** 0.7)
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
@@ -825,6 +841,24 @@ def hang_cards(
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
     return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
+
+
+HANG_SIDE_LIFT_M = 0.005  # hanging hair's most lift off the skull over the sides ...
+# ... round the head: all of it at 100 degrees (over and behind the ears), none 35 degrees
+# off; the temples keep their lift (less there, a bob cut 3 mm into a fuller face's).
+HANG_SIDE_DEG = (100, 35)
+
+
+def _side_lift(points: np.ndarray, centre: np.ndarray, most: np.ndarray) -> np.ndarray:
+    """(N,) m hanging cards passing through ``points`` (N, 3) stand at most off the skull
+    there: ``most`` (N,) over the crown and the back, ``HANG_SIDE_LIFT_M`` over the sides
+    (a smooth step round the head, ``HANG_SIDE_DEG``). Hair falls from the parting down
+    the sides close to the head; lifted 2 cm there, a bob's sides flared out above the
+    ears, 3 cm clear of them."""
+    off = np.abs(around(points, centre) - HANG_SIDE_DEG[0]) / HANG_SIDE_DEG[1]
+    t = np.clip(1 - off, 0, 1)
+    side = t * t * (3 - 2 * t)
+    return most + (np.minimum(HANG_SIDE_LIFT_M, most) - most) * side
 
 
 def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarray:
