@@ -317,17 +317,18 @@ def _half_width(points, centre, z) -> float:
 
 
 def test_bob_falls_close_to_the_head_over_the_sides(body):
-    """From the parting down to ear level a bob's outline (every layer) stays within 2.2
-    cm of the head's (ears included): lifted up to 2 cm off the skull over the sides as
-    over the crown, it flared out 2.7-3.6 cm there."""
+    """Above the ears a bob's outline (every layer) stays within 2 cm of the head's, and
+    within 2.8 cm of the ears at their height: lifted up to 2 cm off the skull over the
+    sides as over the crown, it flared out 2.7 cm above the ears and 3.3-3.6 cm at them."""
     centre, eye_z = hair.head_frame(body)
     points = _edge_points(builtin.BY_NAME["hair-bob"].make(body).mesh)
     skin = body.vertices.astype(np.float64)
-    for z in eye_z + np.array([0.03, 0.015, 0.0]):
+    for up, most in ((0.03, 0.02), (0.015, 0.028), (0.0, 0.028)):
+        z = eye_z + up
         head = np.abs(skin[:, 2] - z) < 0.0025
         head &= np.abs(skin[:, 1] - centre[1]) < 0.04
         gap = _half_width(points, centre, z) - np.abs(skin[head, 0] - centre[0]).max()
-        assert gap < 0.022, (z - eye_z, gap)
+        assert gap < most, (up, gap)
 
 
 def test_buzz_cut_thins_out_at_the_sides_as_at_the_forehead(body):

@@ -843,20 +843,24 @@ def hang_cards(
     return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
 
 
-HANG_SIDE_LIFT_M = 0.005  # hanging hair's most lift off the skull over the sides ...
+HANG_SIDE_LIFT_M = 0.007  # hanging hair's most lift off the skull over the sides ...
 # ... round the head: all of it at 100 degrees (over and behind the ears), none 35 degrees
-# off; the temples keep their lift (less there, a bob cut 3 mm into a fuller face's).
+# off; the temples keep their lift (less there, a bob cut 3 mm into a fuller face's) ...
 HANG_SIDE_DEG = (100, 35)
+# ... and from HANG_SIDE_Z[1] m above the eyes up, none below HANG_SIDE_Z[0]: passing over
+# the ears with less, cards came 2-7 mm inside some small children's ears.
+HANG_SIDE_Z = (0.02, 0.04)
 
 
 def _side_lift(points: np.ndarray, centre: np.ndarray, most: np.ndarray) -> np.ndarray:
     """(N,) m hanging cards passing through ``points`` (N, 3) stand at most off the skull
     there: ``most`` (N,) over the crown and the back, ``HANG_SIDE_LIFT_M`` over the sides
-    (a smooth step round the head, ``HANG_SIDE_DEG``). Hair falls from the parting down
-    the sides close to the head; lifted 2 cm there, a bob's sides flared out above the
-    ears, 3 cm clear of them."""
+    above the ears (a smooth step round the head and up, ``HANG_SIDE_DEG``,
+    ``HANG_SIDE_Z``). Hair falls from the parting down the sides close to the head;
+    lifted 2 cm there, a bob's sides flared out above the ears, 3 cm clear of them."""
     off = np.abs(around(points, centre) - HANG_SIDE_DEG[0]) / HANG_SIDE_DEG[1]
-    t = np.clip(1 - off, 0, 1)
+    above = (points[:, 2] - centre[2] - HANG_SIDE_Z[0]) / (HANG_SIDE_Z[1] - HANG_SIDE_Z[0])
+    t = np.clip(1 - off, 0, 1) * np.clip(above, 0, 1)
     side = t * t * (3 - 2 * t)
     return most + (np.minimum(HANG_SIDE_LIFT_M, most) - most) * side
 
