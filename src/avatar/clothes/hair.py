@@ -825,7 +825,7 @@ def hang_cards(
         fall = np.clip(k / segments * 2.2, 0, 1)  # combed over the crown, then hanging
         direction = along * (1 - fall)[..., None] + np.array([0, 0, -1.0]) * fall
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
-        gap = 0.002 + (_side_lift(point, centre, height) - 0.002) * min(1.0, (k / 3) ** 0.7)
+        gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
         point = _off_skin(body, point + step * direction, gap)
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
@@ -841,28 +841,6 @@ def hang_cards(
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
     return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
-
-
-HANG_SIDE_LIFT_M = 0.007  # hanging hair's most lift off the skull over the sides ...
-# ... round the head: all of it at 100 degrees (over and behind the ears), none 35 degrees
-# off; the temples keep their lift (less there, a bob cut 3 mm into a fuller face's) ...
-HANG_SIDE_DEG = (100, 35)
-# ... and from HANG_SIDE_Z[1] m above the eyes up, none below HANG_SIDE_Z[0]: passing over
-# the ears with less, cards came 2-7 mm inside some small children's ears.
-HANG_SIDE_Z = (0.02, 0.04)
-
-
-def _side_lift(points: np.ndarray, centre: np.ndarray, most: np.ndarray) -> np.ndarray:
-    """(N,) m hanging cards passing through ``points`` (N, 3) stand at most off the skull
-    there: ``most`` (N,) over the crown and the back, ``HANG_SIDE_LIFT_M`` over the sides
-    above the ears (a smooth step round the head and up, ``HANG_SIDE_DEG``,
-    ``HANG_SIDE_Z``). Hair falls from the parting down the sides close to the head;
-    lifted 2 cm there, a bob's sides flared out above the ears, 3 cm clear of them."""
-    off = np.abs(around(points, centre) - HANG_SIDE_DEG[0]) / HANG_SIDE_DEG[1]
-    above = (points[:, 2] - centre[2] - HANG_SIDE_Z[0]) / (HANG_SIDE_Z[1] - HANG_SIDE_Z[0])
-    t = np.clip(1 - off, 0, 1) * np.clip(above, 0, 1)
-    side = t * t * (3 - 2 * t)
-    return most + (np.minimum(HANG_SIDE_LIFT_M, most) - most) * side
 
 
 def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarray:
