@@ -545,3 +545,24 @@ def test_beard_relief_has_no_streaks():
         assert normal.mean(axis=0).std() < 2.0, normal.mean(axis=0).std()
     rough = material.roughness_texture[:128].astype(np.float64)
     assert rough.mean(axis=0).std() < 2.0, rough.mean(axis=0).std()
+
+
+def test_grey_beard_is_a_little_darker_than_grey_scalp_hair():
+    """An old man's grey beard strands are darker than the same texture greyed as scalp
+    hair (at most 0.8 times the median of its light texels): without the hair fabric's
+    relief shading them, at the scalp's grey a beard rendered white as cotton wool."""
+    from dataclasses import replace
+
+    from avatar.looks import facial_hair
+
+    material = load_garment("beard-short", texture_size=256).material
+    scalp_like = replace(material, extras={k: v for k, v in material.extras.items()
+                                           if k != "facial"})  # fmt: skip
+    weights = np.array([0.2126, 0.7152, 0.0722])
+
+    def light(m):
+        tex = facial_hair.for_wearer(m, "cards", 1.0, "dark brown hair").base_color_texture
+        lum = _linear(tex[..., :3])[tex[..., 3] > 127] @ weights
+        return np.median(lum[lum > 0.2])
+
+    assert light(material) < 0.8 * light(scalp_like), light(material) / light(scalp_like)

@@ -132,6 +132,10 @@ def beard_material(spec, size: int = 1024) -> Material:
 # undercoat 0.014) rendered as a black mask. The lift by the hair's linear luminance:
 # FACIAL_LIFT[1] for dark hair up to FACIAL_LIFT_LUM[0], fading to 1 (fair hair, grey).
 FACIAL_LIFT = (1.0, 1.7)
+# ... but a grey beard's grey strands a little darker than the scalp's: unshaded by the
+# hair fabric's relief (``beard_material`` has no normal map), at the scalp's grey an old
+# man's beard rendered white, a mat of cotton wool.
+FACIAL_GREY = 0.75
 FACIAL_LIFT_LUM = (0.04, 0.3)
 
 
@@ -323,6 +327,8 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         else:
             grey = rng.uniform(size=size) < share
         white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey
+        if material.extras.get("facial"):
+            white = white * FACIAL_GREY
         # Grey strands keep the card's strand shading (a flat grey reads as paint), its
         # lights compressed (``GREY_LIGHTS``): a beard's cards, 2.4 times as light as its
         # undercoat, went to pure white, cotton wool.
