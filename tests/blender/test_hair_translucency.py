@@ -5,6 +5,7 @@ each other's shadow), while exporters still find the Principled BSDF."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -19,9 +20,10 @@ def _hair_record(alpha: int = 255):
                     extras={"fabric": "hair"})  # fmt: skip
 
 
-def _backlit_card(tmp_path, record) -> float:
+def _backlit_card(tmp_path, record, front: bool = False) -> float:
     """Mean linear brightness of a hair card seen from the side away from a sun behind
-    it (a black world: only light through the card reaches the camera)."""
+    it (a black world: only light through the card reaches the camera); ``front``: the
+    sun behind the camera instead (only light the card reflects)."""
     import bpy
 
     from avatar.blender import materials, render
@@ -36,7 +38,7 @@ def _backlit_card(tmp_path, record) -> float:
     scene.collection.objects.link(card)
     sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
     sun.data.energy = 3.0
-    sun.rotation_euler = (-math.pi / 2, 0, 0)  # shining towards -y: onto the card's back
+    sun.rotation_euler = (math.pi / 2 if front else -math.pi / 2, 0, 0)  # towards -y: its back
     scene.collection.objects.link(sun)
     cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
     cam.location, cam.rotation_euler = (0, -4, 0), (math.pi / 2, 0, 0)
@@ -65,6 +67,22 @@ def test_hair_card_lets_light_through(empty_scene, tmp_path):
     assert _backlit_card(tmp_path / "clear", _hair_record(alpha=0)) < 0.01
 
 
+def test_blond_hair_lit_from_the_front_reflects_its_colour(empty_scene, tmp_path):
+    """A blond card lit from the front is as light as the same card without light
+    through it (within 10 %): 0.7 times when the Translucent BSDF was mixed in, taking
+    its share from the reflection (blond long hair rendered darker than before)."""
+    from avatar.blender import scene
+    from avatar.looks import fabrics
+
+    record = _hair_record()
+    record.base_color_texture[..., :3] = fabrics.srgb(fabrics.rgb("blond hair"))
+    lit = _backlit_card(tmp_path / "translucent", record, front=True)
+    scene.clear_scene()
+    record = replace(record, extras={**record.extras, "translucency": 0.0})
+    opaque = _backlit_card(tmp_path / "opaque", record, front=True)
+    assert lit > 0.9 * opaque, lit / opaque
+
+
 def test_hair_translucency_keeps_the_cut_out_and_the_exporters_view(empty_scene):
     from bpy_extras.node_shader_utils import PrincipledBSDFWrapper
 
@@ -80,16 +98,21 @@ def test_hair_translucency_keeps_the_cut_out_and_the_exporters_view(empty_scene)
     assert cut.type == "MIX_SHADER"
     assert cut.inputs["Fac"].links[0].from_socket == bsdf.inputs["Alpha"].links[0].from_socket
     assert cut.inputs[1].links[0].from_node.type == "BSDF_TRANSPARENT"
-    fibre = cut.inputs[2].links[0].from_node  # mixed (was added): energy-conserving
-    assert fibre.type == "MIX_SHADER" and fibre.inputs[1].links[0].from_node == bsdf
-    through = fibre.inputs[2].links[0].from_node
+    fibre = cut.inputs[2].links[0].from_node  # added: a share of the unreflected light
+    assert fibre.type == "ADD_SHADER" and fibre.inputs[0].links[0].from_node == bsdf
+    through = fibre.inputs[1].links[0].from_node
     assert through.type == "BSDF_TRANSLUCENT"
-    tint = through.inputs["Color"].links[0].from_node
+    scaled = through.inputs["Color"].links[0].from_node
+    product = scaled.inputs[0].links[0].from_node
+    tint, unreflected = (product.inputs[i].links[0].from_node for i in (0, 1))
     assert tint.inputs["Color"].links[0].from_node.type == "TEX_IMAGE"
-    # The translucent share and the Principled BSDF's add up to one, and the translucent
-    # colour stays within 0..1 (the hair's own to a power at most 1).
-    share = fibre.inputs["Fac"].default_value
-    assert not fibre.inputs["Fac"].links and 0 < share <= 0.5
+    assert unreflected.operation == "SUBTRACT"
+    assert tuple(unreflected.inputs[0].default_value) == (1, 1, 1)
+    assert unreflected.inputs[1].links[0].from_node.type == "TEX_IMAGE"
+    # The translucent colour stays within 0..1 (the hair's own to a power at most 1,
+    # times what it does not reflect, times a share at most 1).
+    share = scaled.inputs["Scale"].default_value
+    assert not scaled.inputs["Scale"].links and 0 < share <= 1.0
     assert tint.type == "GAMMA" and 0 < tint.inputs["Gamma"].default_value <= 1.0
     assert PrincipledBSDFWrapper(mat, is_readonly=True).node_principled_bsdf == bsdf
     cloth = materials.material(_cloth())
@@ -99,8 +122,8 @@ def test_hair_translucency_keeps_the_cut_out_and_the_exporters_view(empty_scene)
 def test_white_hair_sends_on_no_more_light_than_it_receives(empty_scene, tmp_path):
     """A white hair card in a white furnace (a uniform world of brightness 1 lights both
     sides, no other light) is at most as bright as the world: 1.29 when the Translucent
-    BSDF was added to the Principled BSDF (light reflected and passed through at once),
-    0.80 mixed."""
+    BSDF in the hair's colour was added to the Principled BSDF (light reflected and passed
+    through at once), 0.80 mixed, and added as a share of the light not reflected."""
     import bpy
 
     from avatar.blender import materials, render
@@ -171,6 +194,6 @@ def test_beard_passes_less_light_than_scalp_hair(empty_scene):
 
     def amount(name):
         mat = materials.material(load_garment(name, texture_size=64).material)
-        return mat.node_tree.nodes["Hair Translucency"].inputs["Fac"].default_value
+        return mat.node_tree.nodes["Hair Translucency"].inputs["Scale"].default_value
 
     assert amount("beard-short") < 0.5 * amount("hair-short")

@@ -508,3 +508,61 @@ def test_beard_cards_have_little_sheen():
     whole, grey flakes on a dark beard."""
     extras = load_garment("beard-short", texture_size=64).material.extras
     assert float(extras.get("sheen", 0.25)) <= 0.1
+
+
+def test_dark_brown_beard_is_lighter_than_its_hair_colour():
+    """A dark brown beard's undercoat (most of what shows of a full beard) is lighter
+    than the scalp hair's colour (linear luminance at least 1.3 times it: 0.95 times,
+    0.028, rendered as a black mask), and so is a black one; a grey hair's beard is not
+    lifted (within 5 %)."""
+    from avatar.looks import fabrics, facial_hair
+
+    material = load_garment("beard-short", texture_size=256).material
+    weights = np.array([0.2126, 0.7152, 0.0722])
+
+    def undercoat(tex):
+        shown = tex[:128, :, 3] > 127
+        return float((_linear(tex[:128, :, :3])[shown] @ weights).mean())
+
+    for colour in ("dark brown hair", "black hair"):
+        hair = float(fabrics.rgb(colour) @ weights)
+        tex = facial_hair.for_wearer(material, "cards", 0.45, colour).base_color_texture
+        assert undercoat(tex) > 1.3 * hair, undercoat(tex) / hair
+    grey = facial_hair.for_wearer(material, "cards", 0.45, "grey hair").base_color_texture
+    scalp = facial_hair.for_wearer(load_garment("hair-short", texture_size=256).material,
+                                   "cards", 0.45, "grey hair").base_color_texture  # fmt: skip
+    assert undercoat(grey) < 1.05 * undercoat(scalp) / facial_hair.UNDERCOAT_SHADE**2.2
+
+
+def test_beard_relief_has_no_streaks():
+    """A beard's normal map, if it has one, has no grooves running down whole texture
+    columns in its undercoat rows (the spread of the column means of its x component
+    under 2 of 255: 40, the hair fabric's grooves, drew long vertical streaks down a grey
+    beard, the undercoat's v being stretched up the face), nor its roughness."""
+    material = load_garment("beard-short", texture_size=256).material
+    if material.normal_texture is not None:
+        normal = material.normal_texture[:128, :, 0].astype(np.float64)
+        assert normal.mean(axis=0).std() < 2.0, normal.mean(axis=0).std()
+    rough = material.roughness_texture[:128].astype(np.float64)
+    assert rough.mean(axis=0).std() < 2.0, rough.mean(axis=0).std()
+
+
+def test_grey_beard_is_a_little_darker_than_grey_scalp_hair():
+    """An old man's grey beard strands are darker than the same texture greyed as scalp
+    hair (at most 0.8 times the median of its light texels): without the hair fabric's
+    relief shading them, at the scalp's grey a beard rendered white as cotton wool."""
+    from dataclasses import replace
+
+    from avatar.looks import facial_hair
+
+    material = load_garment("beard-short", texture_size=256).material
+    scalp_like = replace(material, extras={k: v for k, v in material.extras.items()
+                                           if k != "facial"})  # fmt: skip
+    weights = np.array([0.2126, 0.7152, 0.0722])
+
+    def light(m):
+        tex = facial_hair.for_wearer(m, "cards", 1.0, "dark brown hair").base_color_texture
+        lum = _linear(tex[..., :3])[tex[..., 3] > 127] @ weights
+        return np.median(lum[lum > 0.2])
+
+    assert light(material) < 0.8 * light(scalp_like), light(material) / light(scalp_like)

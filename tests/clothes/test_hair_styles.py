@@ -298,3 +298,34 @@ def test_long_hair_is_textured_lighter_than_the_roots_inner_layers_most(body):
     tip = verts[:, k - 1]
     gap, _ = body.skin_tree.query(tip)
     assert np.corrcoef(gap, root_v)[0, 1] > 0.3
+
+
+def test_buzz_cut_thins_out_at_the_sides_as_at_the_forehead(body):
+    """A buzz cut's cards thin out towards the scalp's rim round the ears and at the
+    sideburns as at the forehead: within 4 mm of the rim, under a third as many cards as
+    in a band as wide 15-19 mm in (0.46 at the sides, thinned only by the height above
+    the hairline: a crisp side hairline)."""
+    centre, _ = hair.head_frame(body)
+    piece = hair.grow_cards(body, hair.flow_crown(sweep=0.0), builtin.BUZZ_CARDS,
+                            (0.005, 0.009), builtin.BUZZ_WIDTH, (0.0024, 0.003), 1,
+                            root=builtin.BUZZ_ROOT, thin=builtin.BUZZ_HAIRLINE_M)  # fmt: skip
+    cards = piece.mesh.vertices.reshape(-1, 4, 3).astype(np.float64)
+    roots = (cards[:, 0] + cards[:, 2]) / 2
+    from_rim = _from_rim(body, roots)
+    turn = hair.around(roots, centre)
+    for where in ((turn > 60) & (turn < 120), turn < 40):
+        near = (where & (from_rim < 0.004)).sum()
+        inside = (where & (from_rim > 0.015) & (from_rim < 0.019)).sum()
+        assert inside > 15 and near < inside / 3, (near, inside)
+
+
+def _from_rim(body, points) -> np.ndarray:
+    """(N,) m from points to the nearest point on the edge of the scalp (``hairline_mask``)."""
+    from scipy.spatial import cKDTree
+
+    from avatar.geometry.shell import boundary_edges
+
+    edges, _ = boundary_edges(body.skin_faces[hair.hairline_mask(body)])
+    t = np.linspace(0, 1, 5, endpoint=False)[None, :, None]
+    a, b = body.vertices[edges[:, 0]][:, None], body.vertices[edges[:, 1]][:, None]
+    return cKDTree((a * (1 - t) + b * t).reshape(-1, 3)).query(points)[0]

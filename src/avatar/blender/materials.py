@@ -112,11 +112,12 @@ def _new_material(record, fallback_name: str) -> bpy.types.Material:
 # v = 0.5 to tip v = 0, scalp caps bottom to top, lashes lid to tip; ``looks.textures``).
 HAIR_ANISOTROPY = 0.8  # how stretched the highlight is across the strands (0..1)
 HAIR_SHEEN = 0.25  # the soft fibre rim seen at grazing angles
-# Share of light a hair card passes through to its far side (a Translucent BSDF mixed in,
-# in Cycles): hair is a bundle of thin fibres, not a sheet, and lit from behind or through
-# the layers above it glows in its own colour. Opaque cards shadowed each other: long hair
-# hanging below the ears rendered darker than short hair of the same colour.
-HAIR_TRANSLUCENCY = 0.3  # a ``translucency`` hint in a record's extras overrides it
+# Light a hair card passes through to its far side (a Translucent BSDF added, in Cycles):
+# hair is a bundle of thin fibres, not a sheet, and lit from behind or through the layers
+# above it glows in its own colour. Opaque cards shadowed each other: long hair hanging
+# below the ears rendered darker than short hair of the same colour. The share of the
+# light the hair does not reflect (``translucency``): never more light out than in.
+HAIR_TRANSLUCENCY = 0.6  # a ``translucency`` hint in a record's extras overrides it
 HAIR_TINT_GAMMA = 0.25  # the highlight's tint: the hair's colour ** this (0.03 -> 0.42)
 HAIR_THROUGH_GAMMA = 0.5  # the colour of light through hair: the hair's colour ** this
 UV_MAP = "UVMap"  # the layer ``blender.mesh`` makes
@@ -185,36 +186,50 @@ def hair_shading(tree, bsdf: bpy.types.Node, record) -> None:
 
 
 def translucency(tree, bsdf: bpy.types.Node, amount: float = HAIR_TRANSLUCENCY) -> None:
-    """Cycles shades a hair material as its Principled BSDF mixed with a Translucent BSDF
-    in the hair's colour (light through the card from its far side), the translucent share
-    ``amount`` of the light and the Principled BSDF the rest: mixed, not added, so a card
-    never sends on more light than reaches it (added, a light blond card lit from the front
-    and behind at once reflected some 1.3 times the light it received). It is cut out by
-    the same alpha, on a Material Output of its own (target Cycles). The Principled BSDF
-    stays wired to the material's first output (target All): EEVEE draws it, and the FBX
-    and USD exporters look for a Principled BSDF linked straight to an output."""
+    """Cycles shades a hair material as its Principled BSDF plus a Translucent BSDF (light
+    through the card from its far side) in the colour ``amount * c ** HAIR_THROUGH_GAMMA
+    * (1 - c)`` of the hair's colour c: a share of the light the fibres do not reflect,
+    so reflected and passed-on light add up to at most what reaches the card (added in
+    the hair's colour, a white card in a white furnace sent on 1.29 times the light;
+    mixed in, taking ``amount`` of the reflection away, blond hair lit from the front
+    rendered some 30 % darker). It is cut out by the same alpha, on a Material Output of
+    its own (target Cycles). The Principled BSDF stays wired to the material's first
+    output (target All): EEVEE draws it, and the FBX and USD exporters look for a
+    Principled BSDF linked straight to an output."""
     nodes, links = tree.nodes, tree.links
     share = float(np.clip(amount, 0.0, 1.0))
     # Light through a fibre crosses it once, where light reflected diffusely from the hair
     # has crossed many: the transmitted colour is the hair's own raised to a power below
     # one (lighter, more saturated, never above 1: ``HAIR_THROUGH_GAMMA``).
     tint = nodes.new("ShaderNodeGamma")
-    tint.location = (0, -450)
+    tint.location = (-200, -450)
     tint.inputs["Gamma"].default_value = HAIR_THROUGH_GAMMA
+    unreflected = nodes.new("ShaderNodeVectorMath")  # 1 - c: the light not reflected
+    unreflected.operation, unreflected.location = "SUBTRACT", (-200, -600)
+    unreflected.inputs[0].default_value = (1.0, 1.0, 1.0)
     colour = bsdf.inputs["Base Color"]
     if colour.links:
         links.new(colour.links[0].from_socket, tint.inputs["Color"])
+        links.new(colour.links[0].from_socket, unreflected.inputs[1])
     else:
         tint.inputs["Color"].default_value = tuple(colour.default_value)
+        unreflected.inputs[1].default_value = tuple(colour.default_value)[:3]
+    product = nodes.new("ShaderNodeVectorMath")
+    product.operation, product.location = "MULTIPLY", (0, -500)
+    links.new(tint.outputs["Color"], product.inputs[0])
+    links.new(unreflected.outputs["Vector"], product.inputs[1])
+    scaled = nodes.new("ShaderNodeVectorMath")
+    scaled.name = scaled.label = "Hair Translucency"
+    scaled.operation, scaled.location = "SCALE", (150, -500)
+    scaled.inputs["Scale"].default_value = share
+    links.new(product.outputs["Vector"], scaled.inputs[0])
     through = nodes.new("ShaderNodeBsdfTranslucent")
-    through.location = (200, -450)
-    links.new(tint.outputs["Color"], through.inputs["Color"])
-    fibre = nodes.new("ShaderNodeMixShader")
-    fibre.name = fibre.label = "Hair Translucency"
+    through.location = (300, -450)
+    links.new(scaled.outputs["Vector"], through.inputs["Color"])
+    fibre = nodes.new("ShaderNodeAddShader")
     fibre.location = (450, -250)
-    fibre.inputs["Fac"].default_value = share
-    links.new(bsdf.outputs["BSDF"], fibre.inputs[1])
-    links.new(through.outputs["BSDF"], fibre.inputs[2])
+    links.new(bsdf.outputs["BSDF"], fibre.inputs[0])
+    links.new(through.outputs["BSDF"], fibre.inputs[1])
     # Cut out where the Principled BSDF is (its alpha), so the gaps between strands stay
     # see-through: the Translucent BSDF has no alpha of its own.
     cut_out = nodes.new("ShaderNodeMixShader")

@@ -260,7 +260,11 @@ def grow_cards(
     roots = _scatter(body, hairline_mask(body, 0.004), count, rng)
     depth = roots[:, 2] - eye_z - np.interp(around(roots, centre), HAIRLINE_DEG, HAIRLINE_M)
     if thin > 0:
-        kept = rng.uniform(size=count) < np.clip(depth / thin, 0.1, 1)
+        # By the height above the hairline and the distance to the scalp's rim (round
+        # the ears, the sideburns): by the height alone, the cards ran at full density
+        # up to a crisp line at the sides and temples.
+        inside = np.minimum(depth, rim_distance(body, roots))
+        kept = rng.uniform(size=count) < np.clip(inside / thin, 0.1, 1)
         roots, depth, count = roots[kept], depth[kept], int(kept.sum())
     top = lift[0] + (lift[1] - lift[0]) * np.clip(depth / 0.06, 0, 1)
     # Hair lies flat at the crown, where it parts round the whorl.
@@ -298,6 +302,18 @@ def grow_cards(
         _card_piece(body, strands, facing, np.full(count, FRINGE_STRAND_M), rng,
                     taper=rng.uniform(0.2, 0.45, count)),
     ])  # fmt: skip
+
+
+def rim_distance(body: AuthoringBody, points: np.ndarray) -> np.ndarray:
+    """(N,) m from ``points`` (N, 3) to the nearest point of the scalp's rim (the edge of
+    ``hairline_mask``: the hairline, round the ears and down the nape)."""
+    from scipy.spatial import cKDTree
+
+    edges, _ = boundary_edges(body.skin_faces[hairline_mask(body)])
+    a, b = body.vertices[edges[:, 0]], body.vertices[edges[:, 1]]
+    t = np.linspace(0, 1, 5, endpoint=False)[None, :, None]  # points along each edge
+    rim = (a[:, None] * (1 - t) + b[:, None] * t).reshape(-1, 3).astype(np.float64)
+    return cKDTree(rim).query(np.asarray(points, np.float64))[0]
 
 
 # Hair falling over the forehead (a fringe, bangs) as strands this wide (m): a card 2.5 cm

@@ -76,7 +76,8 @@ def grey_share(age: float) -> float:
 # hair layout (v in [0.5, 1]): its hairs cover none of the skin at v = UNDERCOAT_V[0] and
 # all of it from UNDERCOAT_V[1] up.
 UNDERCOAT_V = (0.52, 0.9)
-UNDERCOAT_SHADE = 0.72  # sRGB factor on the undercoat (about half as light, linear)
+UNDERCOAT_SHADE = 0.8  # sRGB factor on the undercoat (some 0.6 as light, linear)
+UNDERCOAT_ROUGHNESS = 0.55  # the hair fabric's mean
 UNDERCOAT_CLIMB = 0.09  # where it is full, v climbs this much up the face (from 0.9)
 
 
@@ -98,6 +99,7 @@ def beard_material(spec, size: int = 1024) -> Material:
     along v, covering more of the skin the higher v is (``UNDERCOAT_V``)."""
     m = textures.hair_material(spec, size)
     colour = np.array(m.base_color_texture, copy=True)
+    colour[..., :3] = _lifted(colour[..., :3], fabrics.rgb(spec.colour))
     rng = np.random.default_rng([size, 17])
     hair = max(size // 340, 1)  # texels per hair across (a card's ~0.12 mm at 1024 px)
     half = size // 2
@@ -110,8 +112,42 @@ def beard_material(spec, size: int = 1024) -> Material:
     # one even mat.
     under = colour[: size - half, :, :3].astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
-    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY, "sheen": BEARD_SHEEN}
-    return replace(m, base_color_texture=colour, extras=extras)
+    # No normal map, and the undercoat's roughness even: the hair fabric's grooves run
+    # the texture's whole height, and on the undercoat, mapped up the face with v
+    # stretched some tenfold (``clothes.face.beard_undercoat``), they drew long vertical
+    # streaks down a grey beard; on the cards alone (they lie at all angles on the
+    # face, a few hairs to a card) they drew dark blotches a centimetre across. A
+    # beard's hairs show in its colour and alpha.
+    rough = np.array(m.roughness_texture, copy=True)
+    rough[: size - half] = int(round(255 * UNDERCOAT_ROUGHNESS))
+    extras = {**m.extras, "translucency": BEARD_TRANSLUCENCY, "sheen": BEARD_SHEEN,
+              "facial": True}  # fmt: skip
+    return replace(m, base_color_texture=colour, normal_texture=None,
+                   roughness_texture=rough, extras=extras)  # fmt: skip
+
+
+# Facial hair is lighter than scalp hair of the same colour: coarser hairs lying in one
+# or two layers on the skin, lit through and between, where scalp hair is a deep pile in
+# its own shade. A dark brown beard in the scalp's albedo (linear luminance 0.03, its
+# undercoat 0.014) rendered as a black mask. The lift by the hair's linear luminance:
+# FACIAL_LIFT[1] for dark hair up to FACIAL_LIFT_LUM[0], fading to 1 (fair hair, grey).
+FACIAL_LIFT = (1.0, 1.7)
+# ... but a grey beard's grey strands a little darker than the scalp's: unshaded by the
+# hair fabric's relief (``beard_material`` has no normal map), at the scalp's grey an old
+# man's beard rendered white, a mat of cotton wool.
+FACIAL_GREY = 0.75
+FACIAL_LIFT_LUM = (0.04, 0.3)
+
+
+def facial_lift(rgb: np.ndarray) -> float:
+    """Brightness factor of facial hair over scalp hair of linear colour ``rgb`` (3,)."""
+    lum = float(np.asarray(rgb, np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32))
+    return float(np.interp(lum, FACIAL_LIFT_LUM, FACIAL_LIFT[::-1]))
+
+
+def _lifted(srgb_u8: np.ndarray, rgb: np.ndarray) -> np.ndarray:
+    """(..., 3) uint8 sRGB texels of facial hair of colour ``rgb`` lifted (``facial_lift``)."""
+    return fabrics.srgb(np.clip(_linear(srgb_u8) * facial_lift(rgb), 0, 1))
 
 
 def card_cover(rows: int, size: int, hair: int, rng) -> np.ndarray:
@@ -148,7 +184,7 @@ def _even_cards(rgb: np.ndarray) -> np.ndarray:
 # Light a beard's cards pass through (the renderer's hint, ``blender.materials``): they lie
 # on the skin, one layer over the undercoat, so little; at scalp hair's 0.6 a grey beard's
 # clumps lit from behind by the key light glowed white, flakes of cotton wool. (A share of
-# the light since the Translucent BSDF is mixed in, not added: scalp hair's is 0.3.)
+# the light the hair does not reflect, as scalp hair's 0.6.)
 BEARD_TRANSLUCENCY = 0.1
 # The fibre rim (Principled sheen) on a beard's cards: at scalp hair's 0.25 a clump lying
 # at a grazing angle to the camera (under the lip, on the chin) lit up as a whole, a grey
@@ -272,6 +308,8 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         rgb = fabrics.rgb(colour).astype(np.float32)
         if kind == "brows":
             rgb = rgb * textures.brow_shade(rgb)
+        elif material.extras.get("facial"):  # a beard, a moustache
+            rgb = rgb * facial_lift(rgb)
         elif kind == "stubble":
             rgb = rgb * 0.7
         lin = rgb[None, None, :] * _strand_shade(tex, kind)[..., None]
@@ -289,6 +327,8 @@ def for_wearer(material: Material, kind: str, age: float, colour=None) -> Materi
         else:
             grey = rng.uniform(size=size) < share
         white = GREY_RGB * (0.55 if kind == "brows" else 1.0)  # brows: coarser, a darker grey
+        if material.extras.get("facial"):
+            white = white * FACIAL_GREY
         # Grey strands keep the card's strand shading (a flat grey reads as paint), its
         # lights compressed (``GREY_LIGHTS``): a beard's cards, 2.4 times as light as its
         # undercoat, went to pure white, cotton wool.
