@@ -441,8 +441,9 @@ def test_the_dress_grid_swaps_swatches_for_pictures_drawn_outside_blender(instal
     import importlib
     import time
 
-    from avatar.clothes import thumbnail
     from extension_fixtures import ADDON
+
+    from avatar.clothes import thumbnail
 
     thumbnails = importlib.import_module(f"{ADDON}.thumbnails")
     thumbnails.release()

@@ -108,3 +108,14 @@ def test_missing_draws_only_what_is_not_cached(tmp_path, monkeypatch, capsys):
     assert cli.main(["clothes", "thumbnails", "cap", "socks", "--missing"]) == 0
     wrote = capsys.readouterr().out
     assert "socks" in wrote and "cap" not in wrote
+
+
+def test_large_faces_are_covered_without_pinholes(human):
+    """An opaque garment's picture at the grid's size has no single-pixel holes: a face is
+    sampled densely enough for the frame (sampled more sparsely, shorts and a skirt drew
+    as dotted grids)."""
+    for name in ("skirt", "shorts"):
+        cloth = _cloth(thumbnail.garment_picture(name, thumbnail.SIZE, human))
+        inner = cloth[:-2, 1:-1] & cloth[2:, 1:-1] & cloth[1:-1, :-2] & cloth[1:-1, 2:]
+        holes = inner & ~cloth[1:-1, 1:-1]
+        assert holes.sum() <= 0.002 * cloth.sum(), (name, int(holes.sum()))

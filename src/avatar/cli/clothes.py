@@ -87,7 +87,8 @@ def run_thumbnails(args: argparse.Namespace) -> int:
     for name in names:
         library.entry_of(name, args.folder or ())  # unknown: ParameterError, close matches
     if args.missing and not args.out:
-        thumbnail.draw_missing(names, args.size)
+        for written in thumbnail.draw_missing(names, args.size):
+            print(f"wrote {written}", flush=True)
         return 0
     human = Human({})
     for name in names:

@@ -89,7 +89,6 @@ def draw_missing(names: list[str] | None = None, size: int = SIZE) -> list[Path]
         if not picture_path(name, size).is_file():
             human = human or Human({})
             written.append(write_picture(name, size, human=human))
-            print(f"wrote {written[-1]}", flush=True)
     return written
 
 
@@ -119,12 +118,19 @@ def picture(fitted: FittedGarment, body, size: int = 128) -> np.ndarray:
     span = max(float((high - low).max()) * _MARGIN, _MIN_SPAN)
     corner = (low + high) / 2 - span / 2  # (x, z) of the picture's bottom-left
     pixel = span / (size * _SUPER)
-    points, colours = _item_samples(fitted, pixel, view[1])
-    body_points, shade, _ = _samples(skin, _skin_quads(body), None, pixel, view[1])
+    frame = (corner, span, view)
+    points, colours = _item_samples(fitted, pixel, frame)
+    body_points, shade, _ = _samples(skin, _skin_quads(body), None, pixel, frame)
     body_colours = np.repeat(shade[:, None], 3, axis=1) * _BODY_GREY
     alpha = np.concatenate([np.ones(len(points)), np.full(len(body_points), _BODY_ALPHA)])
-    return _draw(np.concatenate([points, body_points]) @ view.T,
-                 np.concatenate([colours, body_colours]), alpha, size, corner, span)
+    return _draw(
+        np.concatenate([points, body_points]) @ view.T,
+        np.concatenate([colours, body_colours]),
+        alpha,
+        size,
+        corner,
+        span,
+    )
 
 
 def _yaw(fitted: FittedGarment, top: float) -> int:
@@ -152,38 +158,53 @@ def _skin_quads(body) -> np.ndarray:
 
 
 def _item_samples(fitted: FittedGarment, pixel: float,
-                  away: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+                  frame: tuple) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(N, 3) points on the item and (N, 3) their linear colours, cut-outs dropped."""
     mesh = fitted.mesh
     faces = mesh.faces if mesh.faces.shape[1] == 4 else mesh.faces[:, [0, 1, 2, 2]]
     face_uvs = mesh.face_uvs
     if face_uvs is not None and face_uvs.shape[1] == 3:
         face_uvs = face_uvs[:, [0, 1, 2, 2]]
-    uv_corners = mesh.uvs[face_uvs] if face_uvs is not None else None
+    uv_corners = mesh.uvs[face_uvs] if face_uvs is not None and mesh.uvs is not None else None
     points, shade, uvs = _samples(mesh.vertices.astype(np.float64), faces, uv_corners, pixel,
-                                  away)  # fmt: skip
+                                  frame)  # fmt: skip
     colour, alpha = _texture(fitted.material, uvs, len(points))
     keep = alpha >= _cutoff(fitted.material)
     return points[keep], colour[keep] * shade[keep, None]
 
 
 def _samples(vertices: np.ndarray, quads: np.ndarray, uv_corners: np.ndarray | None,
-             pixel: float, away: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:  # fmt: skip
-    """Points on a grid over every quad (F, 4) (a triangle repeats its last corner), dense
-    enough that neighbours are under a pixel apart; (N,) their face's brightness (the side
-    facing the camera lit; ``away``: the direction it looks); (N, 2) their UVs when
-    ``uv_corners`` (F, 4, 2) is given."""
+             pixel: float, frame: tuple) -> tuple:  # fmt: skip
+    """Points on a grid over every quad (F, 4) (a triangle repeats its last corner) seen in
+    ``frame`` ((x, z) corner, span, view rows), dense enough that neighbours are under a
+    pixel apart; (N,) their face's brightness (the side facing the camera lit); (N, 2)
+    their UVs when ``uv_corners`` (F, 4, 2) is given. Quads outside the frame are skipped
+    (most of the body, for a head's or a foot's picture)."""
+    corner, span, view = frame
+    seen = (vertices @ view.T)[:, [0, 2]][quads]  # (F, 4, 2) on the picture's plane
+    inside = np.all((seen.max(axis=1) >= corner) & (seen.min(axis=1) <= corner + span), axis=1)
+    quads = quads[inside]
+    if uv_corners is not None:
+        uv_corners = uv_corners[inside]
+    if len(quads) == 0:
+        return np.zeros((0, 3)), np.zeros(0), None if uv_corners is None else np.zeros((0, 2))
+    away = view[1]
     corners = vertices[quads]
     normal = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
     normal[normal @ away > 0] *= -1  # light the side that faces the camera
     brightness = _AMBIENT + (1 - _AMBIENT) * np.clip(normal @ _LIGHT, 0.0, 1.0)
-    reach = np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=2).max(axis=1)
-    steps = np.clip(np.ceil(reach / pixel * 1.5), 1, 24).astype(int)
+    # Steps along each of the quad's two directions by its longer side in that direction:
+    # a hair card 2 cm long and 1 mm wide needs many samples along it, few across.
+    edge = np.linalg.norm(corners - np.roll(corners, -1, axis=1), axis=2)  # ab, bc, cd, da
+    along = np.maximum(edge[:, 0], edge[:, 2])
+    across = np.maximum(edge[:, 1], edge[:, 3])
+    steps = np.clip(np.ceil(np.stack([along, across], 1) / pixel * 1.5), 1, 64).astype(int)
     points, shade, uvs = [], [], []
-    for n in np.unique(steps):
-        rows = np.flatnonzero(steps == n)
-        s, t = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
+    pairs, group = np.unique(steps, axis=0, return_inverse=True)
+    for k, (n, m) in enumerate(pairs):
+        rows = np.flatnonzero(group.ravel() == k)
+        s, t = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, m + 1))
         w = _bilinear(s.ravel(), t.ravel())  # (S, 4)
         points.append(np.einsum("sk,fkd->fsd", w, corners[rows]).reshape(-1, 3))
         shade.append(np.repeat(brightness[rows], len(w)))
@@ -252,4 +273,7 @@ def _draw(points: np.ndarray, colours: np.ndarray, alpha: np.ndarray, size: int,
 
 
 if __name__ == "__main__":
-    draw_missing()
+    import sys
+
+    for path in draw_missing():
+        sys.stdout.write(f"wrote {path}\n")
