@@ -479,9 +479,10 @@ def _lacing(foot: Foot, top: Piece, rows: int = LACES) -> Lacing:
     for highest in np.arange(LACE_ROWS[1], LACE_ROWS[0] - 0.1, 0.01):
         at = np.linspace(LACE_ROWS[0], highest, rows)
         x = np.empty(rows)
-        for k, tk in enumerate(at):  # the instep's ridge: the upper's highest point there
-            band = np.abs(t - tk) < 0.03
-            x[k] = v[band][np.argmax(v[band][:, 2]), 0] if band.any() else foot.centre_x
+        for k, tk in enumerate(at):  # the instep's ridge: the middle of its top 0.5 mm (its
+            band = np.abs(t - tk) < 0.03  # highest vertex wandered 1 cm over a flat top)
+            ridge = band & (v[:, 2] > v[band, 2].max() - 0.0005) if band.any() else band
+            x[k] = v[ridge, 0].mean() if ridge.any() else foot.centre_x
         x = np.polyval(np.polyfit(at, x, 1), at)  # one straight throat
         y = foot.heel_y - at * (foot.heel_y - foot.toe_y)
         half = 0.0095 + 0.0045 * (LACE_ROWS[0] - at) / (LACE_ROWS[0] - LACE_ROWS[1])
@@ -740,10 +741,15 @@ def sneakers(body: AuthoringBody) -> Piece:
 # shell, the vamp domed, the toe a ball, the sides bulging over a pinched bottom edge.
 WALL = 0.011
 ROLL = 0.75
-TOE_BOX = 0.013  # m the toe box reaches past the toes
+TOE_BOX = 0.011  # m the toe box reaches past the toes (13 read a little long)
 TAPER = 0.3  # how much narrower the toe box's tip is than the toes' spread
 TOE_EASE = 0.003  # m over the toes (the instep has EASE)
-TOE_TIP = 0.06  # the toe box's tip: this fraction of the foot's length over the ground
+# The toe box's front in profile: its top comes down from over the toes in a curve to
+# NOSE m over the wall at its tip, where the wall is TOE_WALL x WALL high, and the roll
+# over onto the top rounds it (it ran down to a low tip 15 mm over the ground, under the
+# wall's top, with the toe spring rising to meet it: a beak).
+NOSE = 0.0055
+TOE_WALL = 0.3
 VAMP = (0.66, 0.97)  # along the foot: the vamp's straight run, from the throat to the toe
 SHAPED_TO = (0.07, 0.1)  # m above the ground: shaped fully below, not at all above (a boot)
 
@@ -783,15 +789,12 @@ class _Last:
         toe = float(np.interp(b, self.t, top))  # over the toes' tips
         line = ha + (toe - ha) * (self.t - a) / (b - a)
         top = np.where(self.t >= a, np.maximum(line, np.where(self.t <= 1.0, top, -1)), top)
-        # Past the toes the vamp's line runs on down, steepening, to a low tip TOE_TIP x
-        # the foot's length over the ground (it ran on at twice the vamp's slope from
-        # higher over the toes: a tall, square front).
-        reach = 1.0 + TOE_BOX / (foot.heel_y - foot.toe_y)
-        tip = foot.ground + TOE_TIP * (foot.heel_y - foot.toe_y)
-        u = np.clip((self.t - b) / (reach - b), 0, 1)
-        slope = (ha - toe) / (b - a)
-        nose = toe - slope * (self.t - b) * (1 + 1.5 * u)
-        top = np.where(self.t > b, np.maximum(np.minimum(top, nose), tip), top)
+        # Past the toes the vamp's line runs on, curving down to a round nose (``_nose``).
+        reach = float(foot.along(np.column_stack([self.outline, np.zeros(len(self.outline))
+                                                  ])).max())  # fmt: skip
+        front = self.wall(np.array([reach]))[0] + NOSE
+        nose = _nose(self.t, b, reach, toe, (ha - toe) / (b - a), front)
+        top = np.where(self.t > b, np.maximum(np.minimum(top, nose), front), top)
         self.over = over
         # Behind the throat the counter and quarters stand up to the topline, no top.
         self.top = np.maximum(top, 0.3 * np.clip((0.4 - self.t) / 0.1, 0, 1))
@@ -801,12 +804,18 @@ class _Last:
         """(N,) z of the last's bottom edge: EDGE above the ground, curling up at the toe."""
         return self.foot.ground + EDGE + SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
 
+    def wall(self, t: np.ndarray) -> np.ndarray:
+        """(N,) z of the top of the last's upright wall: WALL over its bottom, lower round
+        the toe (TOE_WALL x at its tip), where the front rolls over from low down."""
+        lower = (1 - TOE_WALL) * np.clip((t - 0.9) / 0.15, 0, 1)
+        return self.bottom(t) + WALL * (1 - lower)
+
     def inside(self, q: np.ndarray) -> np.ndarray:
         """(N,) bool: points (N, 3) inside the last."""
         t = self.foot.along(q)
         depth = _depth_in(self.outline, q[:, :2])  # m inside the outline in plan (< 0 out)
         bottom = self.bottom(t)
-        wall = bottom + WALL * (1 - 0.5 * np.clip((t - 0.85) / 0.2, 0, 1))  # lower at the toe
+        wall = self.wall(t)
         height = np.interp(t, self.t, self.top) - wall
         radius = np.clip(np.minimum(ROLL * height, 0.9 * np.interp(t, self.t, self.half)),
                          0.004, None)  # fmt: skip
@@ -837,6 +846,19 @@ class _Last:
         z = points[:, 2] - foot.ground
         weight = np.clip((SHAPED_TO[1] - z) / (SHAPED_TO[1] - SHAPED_TO[0]), 0, 1)[:, None]
         return points + weight * (shaped - points)
+
+
+def _nose(t: np.ndarray, b: float, reach: float, toe: float, slope: float,
+          front: float) -> np.ndarray:  # fmt: skip
+    """(N,) z of the toe box's top at ``t`` past ``b`` (over the toes, at ``toe`` m and
+    coming down ``slope`` m per unit of t): a cubic leaving the vamp's line smoothly and
+    reaching ``front`` at the tip (``reach``) three times as steep."""
+    span = reach - b
+    u = np.clip((t - b) / span, 0, 1)
+    m0, m1 = -slope * span, -3 * slope * span  # slopes per unit of u
+    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+    return h00 * toe + h10 * m0 + h01 * front + h11 * m1
 
 
 def _offset_outline(hull: np.ndarray, ease: float, foot: Foot, n: int = 96) -> np.ndarray:

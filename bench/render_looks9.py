@@ -1,0 +1,49 @@
+"""Render the ninth look pass's shoe close-ups (docs/images/looks9_shoes_*.png): a man in
+shoes, a woman in boots, a child in sneakers, one body a picture, framed closer than
+``render_shoe_last``'s sets, with ``render_closeups``' cameras.
+
+    python bench/render_looks9.py s9-shoes --views profile,front --size 360 --samples 12
+    python bench/render_looks9.py s9-boots --views side --walk
+    python bench/render_looks9.py sheet BEFORE_DIR AFTER_DIR OUT.png s9-shoes_profile ...
+
+``sheet`` puts renders side by side (a row per folder: before over after).
+Needs the pip ``bpy`` module (Cycles on the CPU).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import render_closeups as closeups  # noqa: E402
+import render_shoe_last as shoe_last  # noqa: E402
+
+SETS = {f"s9-{names[-1]}": [(body, names)] for body, names in shoe_last.SETS["s8"]}
+FRAMING = {name: (0.56, 0.55, 0.05) for name in SETS}  # one pair, 56 cm across
+VIEWS = {**shoe_last.VIEWS, "toe": (0.35, -1.0, 0.35)}  # from in front, a little above
+
+
+def sheet(rows: list[str], out: str, stems: list[str]) -> None:
+    """Renders ``stems`` from each folder in ``rows`` side by side, a row per folder."""
+    import numpy as np
+    from PIL import Image
+
+    grid = [np.concatenate([np.asarray(Image.open(Path(r) / f"closeup_{s}.png").convert("RGB"))
+                            for s in stems], 1) for r in rows]  # fmt: skip
+    Image.fromarray(np.concatenate(grid, 0)).save(out, optimize=True)
+
+
+def main() -> None:
+    if sys.argv[1] == "sheet":
+        sheet(sys.argv[2:4], sys.argv[4], sys.argv[5:])
+        return
+    closeups.SETS.update(SETS)
+    closeups.FRAMING.update(FRAMING)
+    closeups.VIEWS.update(VIEWS)
+    closeups.main()
+
+
+if __name__ == "__main__":
+    main()
