@@ -75,3 +75,13 @@ def test_toe_cap_is_faired(body, foot, worn):
     _, i = body.skin_tree.query(v)
     gap = np.einsum("nd,nd->n", v - body.vertices[i], body.skin_normals[i])
     assert gap.min() > shoes.EASE
+
+
+def test_no_stitch_runs_across_the_lacing(body, foot, top):
+    """The tongue's and facings' UVs stay 4 texels and more (at 1024) off the stitch drawn
+    low on the upper (their lowest tenth lay on it: a pale dashed line across their front
+    ends, by the lowest eyelets)."""
+    stitch = (1 - shoes.UPPER_STITCH_V) * 1024
+    for piece in shoes.lacing(body, foot, top)[:2]:  # the tongue, the facings
+        rows = (1 - piece.mesh.uvs[piece.mesh.face_uvs, 1]) * 1024  # (F, 4) texel rows
+        assert not ((rows.min(axis=1) - 4 < stitch) & (rows.max(axis=1) + 4 > stitch)).any()

@@ -239,7 +239,7 @@ def _faired(body: AuthoringBody, mesh: Mesh, ease: float) -> Mesh:
     f = mesh.faces
     a = f.reshape(-1).astype(np.int64)
     b = np.roll(f, -1, axis=1).reshape(-1).astype(np.int64)
-    keep = (a != b)  # a triangle's repeated corner is no edge
+    keep = a != b  # a triangle's repeated corner is no edge
     a, b = a[keep], b[keep]
     held = np.zeros(len(mesh.vertices), bool)
     held[boundary_edges(f)[0].ravel()] = True
@@ -565,6 +565,12 @@ def _sheet(surface: _Surface, xy: np.ndarray, lift: float) -> Mesh | None:
     return Mesh(grid.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
 
 
+# The tongue's and facings' share of their atlas row: above the stitch low on the upper
+# (UPPER_STITCH_V, at 0.14 of the row), which, over all the row, ran across their front
+# ends by the lowest eyelets as a pale dashed line.
+LACING_BAND = (0.3, 0.95)
+
+
 def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> list[Piece]:
     """The lacing on an upper: a tongue, the quarters' facings with their eyelets, and the
     lace criss-crossing between them, one strip from bow to bow (``lace``)."""
@@ -583,7 +589,7 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         v = tongue.vertices.copy()
         v[:, 2] = np.minimum(v[:, 2], _top_eyelets_z(surface, plan) + TONGUE_OVER)
         tongue = Mesh(v, tongue.faces)
-        pieces.append(bound(body, _planar_uvs(tongue, "upper"), faces))
+        pieces.append(bound(body, _planar_uvs(tongue, "upper", LACING_BAND), faces))
     facings = []
     for side in (-1, 1):
         across = [half - 0.005, half + 0.002, half + 0.009]
@@ -592,7 +598,8 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         if sheet is not None:
             facings.append(sheet)
     if facings:
-        pieces.append(bound(body, _planar_uvs(_merge(facings), style.facings), faces))
+        facing_uvs = _planar_uvs(_merge(facings), style.facings, LACING_BAND)
+        pieces.append(bound(body, facing_uvs, faces))
     eyelets = [_disc(surface, xy, 0.0024) for side in (-1, 1) for xy in plan.eyelets(side)]
     pieces.append(bound(body, _planar_uvs(_merge(eyelets), "trim"), faces))
     pieces.append(bound(body, _planar_uvs(lace(surface, plan), "laces"), faces))
@@ -1215,9 +1222,10 @@ def _facing_out(mesh: Mesh, inside: np.ndarray) -> Mesh:
     return Mesh(mesh.vertices, faces)
 
 
-def _planar_uvs(mesh: Mesh, row: str) -> Mesh:
+def _planar_uvs(mesh: Mesh, row: str, band: tuple[float, float] = (0.05, 0.95)) -> Mesh:
     """Per-corner UVs inside the atlas row: the piece seen from its side (y, z) for the
-    upper, toe cap and sole, from above (x, y) for laces, scaled to fit the row."""
+    upper, toe cap and sole, from above (x, y) for laces, scaled to fit the row's ``band``
+    (fractions of its height)."""
     v0, v1 = ROWS[row]
     p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, C, 3)
     if row == "laces":
@@ -1231,6 +1239,7 @@ def _planar_uvs(mesh: Mesh, row: str) -> Mesh:
         u = np.where(wrapped, u + 1.0, u) * 0.5  # [0, 1): faces across the seam stay whole
     u = (u - u.min()) / max(float(np.ptp(u)), 1e-9)
     w = (w - w.min()) / max(float(np.ptp(w)), 1e-9)
-    uvs = np.stack([0.02 + 0.96 * u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1).reshape(-1, 2)
+    w = band[0] + (band[1] - band[0]) * w
+    uvs = np.stack([0.02 + 0.96 * u, v0 + (v1 - v0) * w], -1).reshape(-1, 2)
     face_uvs = np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape)
     return Mesh(mesh.vertices, mesh.faces, uvs.astype(np.float32), face_uvs)
