@@ -85,3 +85,36 @@ def test_no_stitch_runs_across_the_lacing(body, foot, top):
     for piece in shoes.lacing(body, foot, top)[:2]:  # the tongue, the facings
         rows = (1 - piece.mesh.uvs[piece.mesh.face_uvs, 1]) * 1024  # (F, 4) texel rows
         assert not ((rows.min(axis=1) - 4 < stitch) & (rows.max(axis=1) + 4 > stitch)).any()
+
+
+@pytest.mark.parametrize("name", ["shoes", "boots"])
+def test_vamp_has_a_fixed_place_with_flex_creases(body, name):
+    """The vamp (the upper over the ball of the foot) has its own atlas row whose v runs
+    with t along the foot, the same on both feet (the upper was unwrapped round the foot
+    and up it: no texel had a fixed place on the vamp); its normal map has creases across
+    it at the ball: averaged round the foot, the grain cancels and the creases stay."""
+    from avatar.clothes import builtin
+
+    size = 512
+    garment = builtin.build(builtin.BY_NAME[name], body, size)
+    mesh = garment.mesh
+    corner_v = mesh.uvs[mesh.face_uvs, 1]
+    v0, v1 = shoes.ROWS["vamp"]
+    vamp = np.all((corner_v >= v0) & (corner_v <= v1), axis=1)
+    assert vamp.sum() > 100
+    for side in (0, 1):
+        foot = shoes.Foot(body, side)
+        mine = vamp & ((mesh.vertices[mesh.faces[:, 0], 0] > 0) == (side == 0))
+        t = foot.along(mesh.vertices[mesh.faces[mine]].astype(np.float64)).ravel()
+        v = corner_v[mine].ravel()
+        assert np.corrcoef(t, v)[0, 1] > 0.99
+        assert np.allclose(v, [shoes.vamp_v(x) for x in t], atol=0.002)
+
+    def tilt(lo: float, hi: float) -> float:  # RMS of the row-averaged normal's v tilt
+        rows = slice(int(round((1 - shoes.vamp_v(hi)) * size)),
+                     int(round((1 - shoes.vamp_v(lo)) * size)))  # fmt: skip
+        middle = slice(int(0.3 * size), int(0.7 * size))  # over the instep, round the foot
+        n = garment.material.normal_texture[rows, middle, 1].astype(np.float64) / 127.5 - 1
+        return float(np.sqrt((n.mean(axis=1) ** 2).mean()))
+
+    assert tilt(0.66, 0.77) > 0.04 and tilt(0.66, 0.77) > 1.5 * tilt(0.57, 0.63)

@@ -67,9 +67,10 @@ EDGE = 0.002
 DRAWN_CLEAR = 0.003  # m over the ease the drawn edge keeps: room for a sock where the foot flares
 LACES = 5  # eyelet pairs up each side of the lacing
 
-# Atlas rows (v0, v1) in the shoe material: leather upper, trim, toe cap, sole, laces.
-ROWS = {"upper": (0.6, 1.0), "trim": (0.5, 0.6), "cap": (0.3, 0.5), "sole": (0.1, 0.3),
-        "laces": (0.0, 0.1)}  # fmt: skip
+# Atlas rows (v0, v1) in the shoe material: leather upper, the vamp over the ball of the
+# foot (``_vamp_uvs``: a fixed place for its flex creases), trim, toe cap, sole, laces.
+ROWS = {"upper": (0.7, 1.0), "vamp": (0.6, 0.7), "trim": (0.5, 0.6), "cap": (0.3, 0.5),
+        "sole": (0.1, 0.3), "laces": (0.0, 0.1)}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -144,7 +145,46 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, EASE))
     if top <= LOW:
         mesh = _shaft(body, foot, mesh)
-    return bound(body, _planar_uvs(mesh, "upper"), faces)
+    return bound(body, _vamp_uvs(_planar_uvs(mesh, "upper"), foot), faces)
+
+
+# The vamp's place in the atlas: the upper's faces between these fractions of the foot's
+# length (from the heel) over the ball, where the foot bends and the leather creases,
+# above the upper's low stitch (VAMP_CLEAR m over it). Its row's v runs with t, its u
+# round the foot from the inner side (the big toe's) over the instep to the outer side,
+# the same on both feet, so the creases drawn across the row (``_creased``) lie across
+# the vamp where the foot flexes. Unwrapped with the rest of the upper (round the foot,
+# up it), no texel of the atlas had a fixed place on the vamp.
+VAMP_UV = (0.55, 0.85)
+VAMP_CLEAR = 0.004
+
+
+def _vamp_uvs(mesh: Mesh, foot: Foot) -> Mesh:
+    """The upper with its vamp's faces' UVs in the vamp row (``VAMP_UV``)."""
+    p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, C, 3)
+    uvs = mesh.uvs.copy()  # type: ignore[union-attr]
+    low, high = float(p[..., 2].min()), float(p[..., 2].max())
+    stitch = low + (high - low) * 0.1  # the upper's low stitch (UPPER_STITCH_V)
+    t = foot.along(p)
+    vamp = ((t.min(axis=1) > VAMP_UV[0]) & (t.max(axis=1) < VAMP_UV[1])
+            & (p[..., 2].min(axis=1) > stitch + VAMP_CLEAR))  # fmt: skip
+    inner = 1.0 if foot.side == 0 else -1.0  # x > 0 is the left foot: its big toe at -x
+    q = p[vamp]
+    # The angle round the foot's long axis (a line 1 cm over the ground down its middle):
+    # -pi/2 low on the inner side, 0 over the instep, pi/2 low on the outer side.
+    phi = np.arctan2(inner * (q[..., 0] - foot.centre_x), q[..., 2] - (foot.ground + 0.01))
+    u = 0.02 + 0.96 * np.clip(phi / np.pi + 0.5, 0, 1)
+    w = (t[vamp] - VAMP_UV[0]) / (VAMP_UV[1] - VAMP_UV[0])
+    v0, v1 = ROWS["vamp"]
+    corners = mesh.face_uvs[vamp]  # type: ignore[index]
+    uvs[corners] = np.stack([u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1)
+    return Mesh(mesh.vertices, mesh.faces, uvs, mesh.face_uvs)
+
+
+def vamp_v(t: float) -> float:
+    """Atlas v of the vamp at ``t`` along the foot (0 heel, 1 toes)."""
+    v0, v1 = ROWS["vamp"]
+    return v0 + (v1 - v0) * (0.05 + 0.9 * (t - VAMP_UV[0]) / (VAMP_UV[1] - VAMP_UV[0]))
 
 
 # A boot's shaft above the last: SHAFT_EASE m off the skin round the ankle and up the leg,
@@ -1052,6 +1092,7 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
         stitches = [v for i, v in enumerate(stitches) if np.all(np.abs(pixel[:i] - pixel[i]) > 3)]
         m = fabrics.atlas(spec.name, [
             (*ROWS["upper"], upper, upper_colour),
+            (*ROWS["vamp"], upper, upper_colour),
             (*ROWS["trim"], trim_fabric, trim_colour),
             (*ROWS["cap"], upper, cap_colour or upper_colour),
             (*ROWS["sole"], sole, sole_colour),
@@ -1059,11 +1100,12 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
         ], size, stitches=tuple(stitches))  # fmt: skip
         if band is not None:
             _moulded_band(m, fabrics.rgb(band), size)
-        for row in ("upper", "cap"):
+        for row in ("upper", "vamp", "cap"):
             if upper in LEATHERS:
                 _grained(m, ROWS[row], size, GRAIN_STRETCH[row])
             else:
-                _knit_mesh(m, ROWS[row], size)
+                _knit_mesh(m, ROWS[row], size, KNIT_STRETCH.get(row, 1.0))
+        _creased(m, size, 1.0 if upper in LEATHERS else 0.6)
         return m
 
     return material
@@ -1113,9 +1155,11 @@ def _bumped(normal: np.ndarray, height: np.ndarray, slope: float) -> np.ndarray:
 
 # How much taller than wide a grain cell is in each row's texels, so that it is round on
 # the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
-# (~0.25 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm).
-# Square in texels, the pebble was streaked round the quarters and along the cap.
-GRAIN_STRETCH = {"upper": 2.4, "cap": 0.4}
+# (~0.33 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm),
+# the vamp's v along the foot (~0.8 mm) and its u round it (~0.13 mm). Square in texels,
+# the pebble was streaked round the quarters and along the cap.
+GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.4}
+KNIT_STRETCH = {"vamp": 0.16}  # a sneaker's mesh cells, the same way
 
 
 def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
@@ -1139,21 +1183,61 @@ def _grained(m: Material, span: tuple[float, float], size: int, stretch: float =
     rough[rows] = np.clip(r, 0, 255).astype(np.uint8)
 
 
-def _knit_mesh(m: Material, span: tuple[float, float], size: int) -> None:
+def _knit_mesh(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
     """A sneaker's textile upper in one atlas row, in place: an engineered mesh, open
-    cells in a diamond lattice, each a shade darker and sunk in the normal map."""
+    cells in a diamond lattice, each a shade darker and sunk in the normal map; ``stretch``:
+    how much taller than wide a cell is in texels (square on the shoe)."""
     image, normal, rough = m.base_color_texture, m.normal_texture, m.roughness_texture
     assert image is not None and normal is not None and rough is not None
     rows = _rows(span, size)
     h, w = image[rows].shape[:2]
     pitch = max(4, size // 170)
     y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    if stretch < 1:  # cells shorter down the rows than across: as wide as they are tall
+        pitch, x = max(2, int(round(pitch * stretch))), x * stretch
     a = (x + y) * np.pi / pitch
     b = (x - y) * np.pi / pitch
     cells = np.clip(np.sin(a) * np.sin(b), 0, None) ** 0.5  # 1 in a cell's middle, 0 on ribs
     image[rows] = (image[rows].astype(np.float32) * (1 - 0.22 * cells[..., None])).astype(np.uint8)
     normal[rows] = _bumped(normal[rows], -cells, 0.6)
     rough[rows] = np.clip(rough[rows].astype(np.float32) + 30 * cells, 0, 255).astype(np.uint8)
+
+
+# Flex creases across the vamp: at these fractions of the foot's length (the ball's
+# joints, the big toe's further forward: CREASE_TILT over the vamp's width), each an arc
+# across the instep whose ends bend back towards the heel (CREASE_BEND) down the sides,
+# a narrow valley wavering along it, some shallower or broken, fading out low on the
+# sides, with a soft ridge before it.
+CREASES = (0.67, 0.7, 0.73, 0.755)
+CREASE_TILT = 0.03
+CREASE_BEND = 0.05
+CREASE_SLOPE = 1.4  # the normal map's tilt per unit of the crease's depth per texel
+
+
+def _creased(m: Material, size: int, strength: float = 1.0) -> None:
+    """Flex creases in the vamp row's normal map (and a shade darker in their valleys),
+    in place (``CREASES``; u in the row runs round the foot, v along it: ``_vamp_uvs``)."""
+    image, normal = m.base_color_texture, m.normal_texture
+    assert image is not None and normal is not None
+    rows = _rows(ROWS["vamp"], size)
+    h, w = normal[rows].shape[:2]
+    y = np.arange(h, dtype=np.float64)[:, None]  # texel rows down the vamp row
+    u = np.clip((np.arange(w) / w - 0.02) / 0.96, 0, 1)  # 0 low inside, 1 low outside
+    side = np.abs(2 * u - 1)  # 0 over the instep, 1 low on either side
+    across = np.clip(1.25 - 1.25 * side, 0, 1) ** 1.5  # fades out down the sides
+    rng = np.random.default_rng(14)
+    height = np.zeros((h, w))
+    for t in CREASES:
+        line = t + CREASE_TILT * (0.5 - u) - CREASE_BEND * side**2
+        waver = 1.2 * _smooth_noise(rng, (1, w), max(8, w // 10))[0]  # texels at 1024
+        centre = (1 - np.array([vamp_v(x) for x in line])) * size - rows.start
+        d = (y - centre[None]) * 1024 / size - waver[None]  # texels at 1024 off the line
+        depth = np.clip(0.35 + 0.9 * _smooth_noise(rng, (1, w), max(8, w // 5))[0], 0, 1)
+        valley = np.exp(-((d / 1.3) ** 2)) - 0.3 * np.exp(-(((d + 2.2) / 1.8) ** 2))
+        height -= depth * across * valley
+    normal[rows] = _bumped(normal[rows], height * strength * size / 1024, CREASE_SLOPE)
+    shade = 1 - 0.08 * strength * np.clip(-height, 0, 1)
+    image[rows] = (image[rows].astype(np.float32) * shade[..., None]).astype(np.uint8)
 
 
 def _moulded_band(m: Material, colour: np.ndarray, size: int) -> None:
