@@ -4,7 +4,7 @@ shoes, a woman in boots, a child in sneakers, one body a picture, framed closer 
 
     python bench/render_looks9.py s9-shoes --views profile,front --size 360 --samples 12
     python bench/render_looks9.py s9-boots --views side --walk
-    python bench/render_looks9.py s9-shoes --views toe --at 0.1,-0.12,0.12  # one shoe
+    python bench/render_looks9.py s9-shoes --views toe --at 0.2,-0.12,0.16  # one shoe
     python bench/render_looks9.py sheet BEFORE_DIR AFTER_DIR OUT.png s9-shoes_profile ...
 
 ``sheet`` puts renders side by side (a row per folder: before over after).
@@ -36,8 +36,9 @@ def sheet(rows: list[str], out: str, stems: list[str]) -> None:
     Image.fromarray(np.concatenate(grid, 0)).save(out, optimize=True)
 
 
-def _aimed_at(x: float, y: float, width: float):
-    """``render_closeups``' camera aimed at (x, y), ``width`` m across (one shoe close)."""
+def _aimed_at(x: float, y: float, width: float, z: float | None = None):
+    """``render_closeups``' camera aimed at (x, y, z: the set's aim height if None),
+    ``width`` m across (one shoe close)."""
     import numpy as np
 
     from avatar.blender.camera import add_camera
@@ -45,7 +46,7 @@ def _aimed_at(x: float, y: float, width: float):
 
     def aim(direction, _width: float, size: tuple[int, int], height: float) -> None:
         back = np.asarray(direction, float) / np.linalg.norm(direction)
-        centre = np.array([x, y, height])
+        centre = np.array([x, y, height if z is None else z])
         distance = width / 2 * 85.0 / 18.0
         add_camera(CameraModel(85.0, 36.0, 24.0, "HORIZONTAL", 0.0, 0.0, size, 100, (1.0, 1.0),
                                look_at(centre + back * distance, centre)))  # fmt: skip
@@ -57,7 +58,7 @@ def main() -> None:
     if sys.argv[1] == "sheet":
         sheet(sys.argv[2:4], sys.argv[4], sys.argv[5:])
         return
-    if "--at" in sys.argv:  # --at x,y,width: one shoe, close (the left one: x ~ 0.1)
+    if "--at" in sys.argv:  # --at x,y,width[,z]: one shoe, close (the left one: x ~ 0.2)
         i = sys.argv.index("--at")
         closeups._aim = _aimed_at(*(float(a) for a in sys.argv[i + 1].split(",")))
         del sys.argv[i : i + 2]

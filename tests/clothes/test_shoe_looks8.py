@@ -126,10 +126,12 @@ def _triangles(name: str, body) -> int:
 def test_a_pair_is_about_eight_thousand_triangles(body):
     """11,576 triangles a pair (boots 14,824) before, now 8,188 (boots 10,264): the lace's
     crown, eyelet fans, the sole's fan and ring, the upper under the toe cap and above the
-    throat are gone or lighter; a boot's shaft is not split finer above the last."""
+    throat are gone or lighter; a boot's shaft is not split finer above the last. The
+    ninth pass laces boots up the shaft (facings, eyelets, the lace's two ends and the
+    bow up its front): 11,184."""
     assert _triangles("shoes", body) < 8300
     assert _triangles("sneakers", body) < 8500
-    assert _triangles("boots", body) < 10500
+    assert _triangles("boots", body) < 11300
 
 
 def _sneaker_proportions(params: dict) -> tuple[float, float]:

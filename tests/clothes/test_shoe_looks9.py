@@ -118,3 +118,25 @@ def test_vamp_has_a_fixed_place_with_flex_creases(body, name):
         return float(np.sqrt((n.mean(axis=1) ** 2).mean()))
 
     assert tilt(0.66, 0.77) > 0.04 and tilt(0.66, 0.77) > 1.5 * tilt(0.57, 0.63)
+
+
+def test_boots_are_laced_up_the_shaft(body):
+    """A boot's eyelets and lace run on up the front of its shaft to within 3 cm of the
+    collar (they stopped over the instep, 11 cm under it), the lace's ends crossing
+    between every pair of rows there; a low shoe has no rows up a shaft."""
+    foot = shoes.Foot(body, 0)
+    top = shoes.upper(body, foot, 0.86)
+    collar = top.mesh.vertices[:, 2].max()
+    pieces = shoes.lacing(body, foot, top)
+    rows = shoes._shaft_rows(foot, top, shoes._lacing(foot, top), shoes._Surface(top.mesh))
+    assert rows is not None and len(rows.z) >= 4
+    eyelets = np.concatenate([p.mesh.vertices for p in pieces
+                              if np.all(np.abs(p.mesh.uvs[:, 1] - 0.55) < 0.05)])  # fmt: skip
+    laces = np.concatenate([p.mesh.vertices for p in pieces if p.mesh.uvs[:, 1].max() <= 0.1])
+    assert collar - eyelets[:, 2].max() < 0.03 and collar - laces[:, 2].max() < 0.03
+    for k in range(1, len(rows.z) - 1):  # an X between rows: both ends near the middle
+        z, x = (rows.z[k] + rows.z[k + 1]) / 2, (rows.x[k] + rows.x[k + 1]) / 2
+        near = laces[(np.abs(laces[:, 2] - z) < 0.003) & (np.abs(laces[:, 0] - x) < 0.003)]
+        assert len(near) >= 2 and np.ptp(near[:, 1]) > 0.0005, k  # one over the other
+    low = shoes.upper(body, foot)
+    assert shoes._shaft_rows(foot, low, shoes._lacing(foot, low), shoes._Surface(low.mesh)) is None
