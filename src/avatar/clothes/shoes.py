@@ -17,16 +17,18 @@ Parts, per foot (``x > 0`` is the body's left):
   the foot, taller at the heel (a heel block with a breast: the waist lifted under the
   arch), curling up at the toe (toe spring), closed underneath;
 - toe cap: the front of the upper again, on the same last 1.2 mm out, its back edge
-  (the seam over the vamp) smoothed into a curve, skived down onto the vamp
-  (``_skived``) and double-stitched;
+  (the seam over the vamp) smoothed into a curve, its surface faired (``_faired``),
+  skived down onto the vamp (``_skived``) and double-stitched;
 - lacing (``lacing``): a tongue lying on the instep under the laces, two quarters'
   facings either side of it with eyelets, and one lace criss-crossing from eyelet to
-  eyelet (each crossing over the one before), tied in a bow at the top;
+  eyelet (each crossing over the one before), tied in a bow at the top; a boot's goes
+  on up the front of its shaft (``shaft_lacing``) to the bow under the collar;
 - a sneaker (``SNEAKER``) on a deep rubber midsole wrapping up over the toe (a toe
   bumper), with a band moulded round it, and a heel tab.
 
 They share one material: an atlas (``look``) whose rows hold leather (grained:
-``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), trim (eyelets, a
+``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), the vamp's leather with
+flex creases across the ball (``_vamp_uvs``, ``_creased``), trim (eyelets, a
 sneaker's facings and heel tab), toe-cap leather, sole and lace cord, each piece's UVs
 laid out inside its row; the toe cap's and sole's UVs run from their seams, so stitching
 drawn across the atlas follows the cap's edge and the welt.
