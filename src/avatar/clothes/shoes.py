@@ -1281,12 +1281,15 @@ def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], cell: int,
     return top + (c + (d - c) * fx[None] - top) * fy[:, None]
 
 
-def _bumped(normal: np.ndarray, height: np.ndarray, slope: float) -> np.ndarray:
-    """(H, W, 3) uint8 tangent-space normals tilted by the gradient of ``height`` (H, W)."""
+def _bumped(normal: np.ndarray, height: np.ndarray, slope: float,
+            aspect: float = 1.0) -> np.ndarray:  # fmt: skip
+    """(H, W, 3) uint8 tangent-space normals tilted by the gradient of ``height`` (H, W);
+    ``aspect``: a texel's width over its height on the garment (its slope down the rows is
+    per that much less surface)."""
     n = normal.astype(np.float32) / 127.5 - 1
     gy, gx = np.gradient(height)
     n[..., 0] -= slope * gx
-    n[..., 1] += slope * gy  # image rows run down the texture, v up
+    n[..., 1] += slope * aspect * gy  # image rows run down the texture, v up
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     return np.clip((n + 1) * 127.5, 0, 255).astype(np.uint8)
 
@@ -1315,7 +1318,10 @@ def _grained(m: Material, span: tuple[float, float], size: int, stretch: float =
     pebble = np.abs(_smooth_noise(rng, shape, cell, stretch)) + 0.5 * np.abs(
         _smooth_noise(rng, shape, 2 * cell, stretch))
     height = -pebble  # pores and pebble valleys between raised grains
-    normal[rows] = _bumped(normal[rows], height, GRAIN)
+    # The vamp's texels are 6 times longer along the foot than round it: per texel, its
+    # grain's slopes along the foot were 6 times too steep (streaks across the vamp).
+    normal[rows] = _bumped(normal[rows], height, GRAIN, min(1.0, stretch) if span == ROWS["vamp"]
+                           else 1.0)  # fmt: skip
     patches = _smooth_noise(rng, shape, max(8, size // 24))
     r = rough[rows].astype(np.float32) + 255 * (0.1 + 0.07 * patches + 0.08 * pebble)
     rough[rows] = np.clip(r, 0, 255).astype(np.uint8)
