@@ -27,13 +27,21 @@ VIEWS = {**shoe_last.VIEWS, "toe": (0.35, -1.0, 0.35)}  # from in front, a littl
 
 
 def sheet(rows: list[str], out: str, stems: list[str]) -> None:
-    """Renders ``stems`` from each folder in ``rows`` side by side, a row per folder."""
+    """Renders ``stems`` from each folder in ``rows`` side by side, a row per folder (two:
+    labelled before and after), saved with a 256-colour palette (docs pictures < 400 KB)."""
     import numpy as np
-    from PIL import Image
+    from PIL import Image, ImageDraw
 
     grid = [np.concatenate([np.asarray(Image.open(Path(r) / f"closeup_{s}.png").convert("RGB"))
                             for s in stems], 1) for r in rows]  # fmt: skip
-    Image.fromarray(np.concatenate(grid, 0)).save(out, optimize=True)
+    image = Image.fromarray(np.concatenate(grid, 0))
+    if len(rows) == 2:
+        draw = ImageDraw.Draw(image)
+        for k, label in enumerate(("before", "after")):
+            y = k * grid[0].shape[0]
+            draw.rectangle((0, y, 60, y + 14), fill=(0, 0, 0))
+            draw.text((4, y + 1), label, fill=(255, 255, 255))
+    image.quantize(256, method=Image.Quantize.MEDIANCUT).save(out, optimize=True)
 
 
 def _aimed_at(x: float, y: float, width: float, z: float | None = None):
