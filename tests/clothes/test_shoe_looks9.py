@@ -167,3 +167,14 @@ def test_a_childs_sneakers_are_as_wide_for_the_foot_as_an_adults():
               _ball_width_over_foot({"gender": 0.0, "age": 0.45})]  # fmt: skip
     child = _ball_width_over_foot({"gender": 0.3, "age": 0.12})
     assert child < 1.02 * np.mean(adults), (child, adults)
+
+
+def test_a_childs_thinner_soles_stand_on_the_floor():
+    """The lowest point of a child's shoes (their shell thinned with the foot) within
+    0.3 mm of the floor: the body's lift (``footing.sole_height``) grows the shell by the
+    same worn thickness (grown by the authored 2.5 mm, the soles floated 0.7 mm over it)."""
+    from avatar.human import Human
+
+    for name in ("sneakers", "boots"):
+        human = Human({"gender": 0.3, "age": 0.12}).dressed(name)
+        assert abs(float(human.outfit.garments[0].mesh.vertices[:, 2].min())) < 0.0003, name
