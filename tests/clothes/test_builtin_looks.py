@@ -159,7 +159,7 @@ def test_shoes_have_sole_heel_toe_cap_and_laces(body):
 
     mesh = builtin.BY_NAME["shoes"].make(body).mesh
     rows = _rows_of(mesh)
-    assert set(rows) == {"upper", "trim", "cap", "sole", "laces"}  # trim: the eyelets
+    assert set(rows) == {"upper", "vamp", "trim", "cap", "sole", "laces"}  # trim: the eyelets
     left = mesh.vertices[:, 0] > 0
     foot = shoes.Foot(body, 0)
     v = mesh.vertices[left]
@@ -187,7 +187,7 @@ def test_shoes_have_sole_heel_toe_cap_and_laces(body):
 def test_shoe_material_is_an_atlas_of_leather_sole_and_cord():
     m = builtin.build(builtin.BY_NAME["shoes"], library.authoring_body(), 256).material
     assert m.base_color_texture.shape == (256, 256, 3) and m.normal_texture is not None
-    assert [row[2] for row in m.extras["rows"]] == ["calf", "calf", "calf", "sole", "cord"]
+    assert [row[2] for row in m.extras["rows"]] == ["calf", "calf", "calf", "calf", "sole", "cord"]
     image = m.base_color_texture.astype(float)
     upper = image[int(256 * 0.25)].mean(0)
     sole, laces = image[int(256 * 0.75)].mean(0), image[int(256 * 0.95)].mean(0)

@@ -33,9 +33,10 @@ def top(body, foot):
 def test_toe_box_is_low_past_the_toes(foot, top):
     """The toe box slopes down from the toes' front to a low tip (over the toes' front it
     stood 30 mm tall, 25 mm 3 mm further on: a tall, square front; now 25 and 22) and ends
-    closer to them (16 mm past, now 13)."""
+    closer to them (16 mm past, now 13). The ninth pass rounds its nose (a beak before:
+    ``test_shoe_looks9``), a millimetre or three higher near the front: 27.5 and 26 mm."""
     v = top.mesh.vertices.astype(np.float64)
-    for past, most in ((0.0, 0.027), (0.003, 0.0235)):
+    for past, most in ((0.0, 0.028), (0.003, 0.0265)):
         ahead = v[v[:, 1] < foot.toe_y - past]
         assert ahead[:, 2].max() - foot.ground < most, past
     assert foot.toe_y - v[:, 1].min() < 0.015
@@ -52,7 +53,8 @@ def test_sole_edge_is_flush_with_the_upper(body, foot, top):
         s, u = sole[(t_s > lo) & (t_s < hi)], upper[(t_u > lo) & (t_u < hi)]
         for sign in (-1, 1):
             over = sign * (s[:, 0] - foot.centre_x)
-            assert over.max() - (sign * (u[:, 0] - foot.centre_x)).max() < 0.0032
+            # 3.2 mm before the ninth pass's shorter toe box turned the sole's ring (3.3)
+            assert over.max() - (sign * (u[:, 0] - foot.centre_x)).max() < 0.0035
     waist = sole[(t_s > 0.38) & (t_s < 0.5)]
     heel = sole[t_s < 0.2]
     assert waist[:, 2].min() - heel[:, 2].min() > 0.005
@@ -124,10 +126,12 @@ def _triangles(name: str, body) -> int:
 def test_a_pair_is_about_eight_thousand_triangles(body):
     """11,576 triangles a pair (boots 14,824) before, now 8,188 (boots 10,264): the lace's
     crown, eyelet fans, the sole's fan and ring, the upper under the toe cap and above the
-    throat are gone or lighter; a boot's shaft is not split finer above the last."""
+    throat are gone or lighter; a boot's shaft is not split finer above the last. The
+    ninth pass laces boots up the shaft (facings, eyelets, the lace's two ends and the
+    bow up its front): 11,184."""
     assert _triangles("shoes", body) < 8300
     assert _triangles("sneakers", body) < 8500
-    assert _triangles("boots", body) < 10500
+    assert _triangles("boots", body) < 11300
 
 
 def _sneaker_proportions(params: dict) -> tuple[float, float]:

@@ -4,9 +4,10 @@ A shaped body stands with its feet on z = 0 (``body.shaped.rest_vertices``). A s
 lies under the foot, so a shod body must stand up by the sole's depth, or the sole sinks
 into the floor. ``sole_height`` measures that depth on the body itself: the footwear's
 binding evaluated on it (what ``fitting`` does first) and the shell's outer layer grown
-along the skin normal, as ``fitting`` grows it; the lowest of those points is how far the
-floor is below the soles. The composition root (``Human``) lifts the body, and so its
-rig and every garment, by that much, and lifts settled poses by it too.
+along the skin normal by its ``worn_thickness``, as ``fitting`` grows it; the lowest of
+those points is how far the floor is below the soles. The composition root (``Human``)
+lifts the body, and so its rig and every garment, by that much, and lifts settled poses
+by it too.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 from avatar.body.model import BODY_VERTICES, BodyModel
 from avatar.clothes import builtin
 from avatar.clothes.binding import fit
+from avatar.clothes.fitting import worn_thickness
 from avatar.geometry import collision
 
 FOOTWEAR = "footwear"
@@ -56,7 +58,7 @@ def sole_height(
         # Only the bottom matters: the points within 2 cm of the lowest.
         low = points[points[:, 2] < points[:, 2].min() + 0.02]
         q = collision.query(skin, surface, low, k=4)
-        outer = low + np.float32(garment.thickness) * q.normal
+        outer = low + np.float32(worn_thickness(garment, vertices)) * q.normal
         lowest = min(lowest, float(low[:, 2].min()), float(outer[:, 2].min()))
     return max(0.0, -lowest)
 

@@ -17,16 +17,18 @@ Parts, per foot (``x > 0`` is the body's left):
   the foot, taller at the heel (a heel block with a breast: the waist lifted under the
   arch), curling up at the toe (toe spring), closed underneath;
 - toe cap: the front of the upper again, on the same last 1.2 mm out, its back edge
-  (the seam over the vamp) smoothed into a curve, skived down onto the vamp
-  (``_skived``) and double-stitched;
+  (the seam over the vamp) smoothed into a curve, its surface faired (``_faired``),
+  skived down onto the vamp (``_skived``) and double-stitched;
 - lacing (``lacing``): a tongue lying on the instep under the laces, two quarters'
   facings either side of it with eyelets, and one lace criss-crossing from eyelet to
-  eyelet (each crossing over the one before), tied in a bow at the top;
+  eyelet (each crossing over the one before), tied in a bow at the top; a boot's goes
+  on up the front of its shaft (``shaft_lacing``) to the bow under the collar;
 - a sneaker (``SNEAKER``) on a deep rubber midsole wrapping up over the toe (a toe
   bumper), with a band moulded round it, and a heel tab.
 
 They share one material: an atlas (``look``) whose rows hold leather (grained:
-``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), trim (eyelets, a
+``_grained``; a sneaker's textile a knit mesh: ``_knit_mesh``), the vamp's leather with
+flex creases across the ball (``_vamp_uvs``, ``_creased``), trim (eyelets, a
 sneaker's facings and heel tab), toe-cap leather, sole and lace cord, each piece's UVs
 laid out inside its row; the toe cap's and sole's UVs run from their seams, so stitching
 drawn across the atlas follows the cap's edge and the welt.
@@ -67,9 +69,10 @@ EDGE = 0.002
 DRAWN_CLEAR = 0.003  # m over the ease the drawn edge keeps: room for a sock where the foot flares
 LACES = 5  # eyelet pairs up each side of the lacing
 
-# Atlas rows (v0, v1) in the shoe material: leather upper, trim, toe cap, sole, laces.
-ROWS = {"upper": (0.6, 1.0), "trim": (0.5, 0.6), "cap": (0.3, 0.5), "sole": (0.1, 0.3),
-        "laces": (0.0, 0.1)}  # fmt: skip
+# Atlas rows (v0, v1) in the shoe material: leather upper, the vamp over the ball of the
+# foot (``_vamp_uvs``: a fixed place for its flex creases), trim, toe cap, sole, laces.
+ROWS = {"upper": (0.7, 1.0), "vamp": (0.6, 0.7), "trim": (0.5, 0.6), "cap": (0.3, 0.5),
+        "sole": (0.1, 0.3), "laces": (0.0, 0.1)}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -144,7 +147,46 @@ def upper(body: AuthoringBody, foot: Foot, top: float = 0.96) -> Piece:
     mesh = _drawn_down(body, foot, _toe_box(body, foot, mesh, EASE))
     if top <= LOW:
         mesh = _shaft(body, foot, mesh)
-    return bound(body, _planar_uvs(mesh, "upper"), faces)
+    return bound(body, _vamp_uvs(_planar_uvs(mesh, "upper"), foot), faces)
+
+
+# The vamp's place in the atlas: the upper's faces between these fractions of the foot's
+# length (from the heel) over the ball, where the foot bends and the leather creases,
+# above the upper's low stitch (VAMP_CLEAR m over it). Its row's v runs with t, its u
+# round the foot from the inner side (the big toe's) over the instep to the outer side,
+# the same on both feet, so the creases drawn across the row (``_creased``) lie across
+# the vamp where the foot flexes. Unwrapped with the rest of the upper (round the foot,
+# up it), no texel of the atlas had a fixed place on the vamp.
+VAMP_UV = (0.55, 0.85)
+VAMP_CLEAR = 0.004
+
+
+def _vamp_uvs(mesh: Mesh, foot: Foot) -> Mesh:
+    """The upper with its vamp's faces' UVs in the vamp row (``VAMP_UV``)."""
+    p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, C, 3)
+    uvs = mesh.uvs.copy()  # type: ignore[union-attr]
+    low, high = float(p[..., 2].min()), float(p[..., 2].max())
+    stitch = low + (high - low) * 0.1  # the upper's low stitch (UPPER_STITCH_V)
+    t = foot.along(p)
+    vamp = ((t.min(axis=1) > VAMP_UV[0]) & (t.max(axis=1) < VAMP_UV[1])
+            & (p[..., 2].min(axis=1) > stitch + VAMP_CLEAR))  # fmt: skip
+    inner = 1.0 if foot.side == 0 else -1.0  # x > 0 is the left foot: its big toe at -x
+    q = p[vamp]
+    # The angle round the foot's long axis (a line 1 cm over the ground down its middle):
+    # -pi/2 low on the inner side, 0 over the instep, pi/2 low on the outer side.
+    phi = np.arctan2(inner * (q[..., 0] - foot.centre_x), q[..., 2] - (foot.ground + 0.01))
+    u = 0.02 + 0.96 * np.clip(phi / np.pi + 0.5, 0, 1)
+    w = (t[vamp] - VAMP_UV[0]) / (VAMP_UV[1] - VAMP_UV[0])
+    v0, v1 = ROWS["vamp"]
+    corners = mesh.face_uvs[vamp]  # type: ignore[index]
+    uvs[corners] = np.stack([u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1)
+    return Mesh(mesh.vertices, mesh.faces, uvs, mesh.face_uvs)
+
+
+def vamp_v(t: float) -> float:
+    """Atlas v of the vamp at ``t`` along the foot (0 heel, 1 toes)."""
+    v0, v1 = ROWS["vamp"]
+    return v0 + (v1 - v0) * (0.05 + 0.9 * (t - VAMP_UV[0]) / (VAMP_UV[1] - VAMP_UV[0]))
 
 
 # A boot's shaft above the last: SHAFT_EASE m off the skin round the ankle and up the leg,
@@ -221,7 +263,43 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     # down to the sole at the sides and was dragged into spikes.
     mesh = _toe_box(body, foot, mesh, CAP_EASE, smooth_rim=6)
     mesh = _drawn_down(body, foot, mesh, reach=OPEN_BOTTOM)
+    mesh = _faired(body, mesh, CAP_EASE)
     return bound(body, _cap_uvs(_skived(mesh, foot), foot), faces)
+
+
+FAIR_PASSES = 20  # Taubin passes over the toe cap (its folds 55-70 degrees before)
+
+
+def _faired(body: AuthoringBody, mesh: Mesh, ease: float) -> Mesh:
+    """The toe cap's surface faired: Taubin-smoothed (a shrinking pass, then an inflating
+    one, so the nose keeps its size) with its edges held, then no nearer the skin than
+    ``ease``. The last is sampled by the helper's few big faces over the toes, stretched
+    14 mm past them, and the edge drawn down to the sole: the cap folded up to 55-70
+    degrees between neighbouring faces, and the grain's highlights showed each fold."""
+    from avatar.geometry.shell import boundary_edges
+
+    f = mesh.faces
+    a = f.reshape(-1).astype(np.int64)
+    b = np.roll(f, -1, axis=1).reshape(-1).astype(np.int64)
+    keep = a != b  # a triangle's repeated corner is no edge
+    a, b = a[keep], b[keep]
+    held = np.zeros(len(mesh.vertices), bool)
+    held[boundary_edges(f)[0].ravel()] = True
+    count = np.zeros(len(held))
+    np.add.at(count, a, 1)
+    np.add.at(count, b, 1)
+    p = mesh.vertices.astype(np.float64)
+    for k in range(2 * FAIR_PASSES):
+        total = np.zeros_like(p)
+        np.add.at(total, a, p[b])
+        np.add.at(total, b, p[a])
+        step = total / np.maximum(count, 1)[:, None] - p
+        p = p + np.where(held[:, None], 0, (0.5 if k % 2 == 0 else -0.53) * step)
+    _, i = body.skin_tree.query(p)
+    normal = body.skin_normals[i].astype(np.float64)
+    gap = np.einsum("nd,nd->n", p - body.vertices[i], normal)
+    p += np.clip(ease - gap, 0, None)[:, None] * normal * ~held[:, None]
+    return Mesh(p.astype(np.float32), f, mesh.uvs, mesh.face_uvs)
 
 
 SKIVE = 0.008  # m from the toe cap's seam over which its edge is thinned down to the vamp
@@ -479,9 +557,10 @@ def _lacing(foot: Foot, top: Piece, rows: int = LACES) -> Lacing:
     for highest in np.arange(LACE_ROWS[1], LACE_ROWS[0] - 0.1, 0.01):
         at = np.linspace(LACE_ROWS[0], highest, rows)
         x = np.empty(rows)
-        for k, tk in enumerate(at):  # the instep's ridge: the upper's highest point there
-            band = np.abs(t - tk) < 0.03
-            x[k] = v[band][np.argmax(v[band][:, 2]), 0] if band.any() else foot.centre_x
+        for k, tk in enumerate(at):  # the instep's ridge: the middle of its top 0.5 mm (its
+            band = np.abs(t - tk) < 0.03  # highest vertex wandered 1 cm over a flat top)
+            ridge = band & (v[:, 2] > v[band, 2].max() - 0.0005) if band.any() else band
+            x[k] = v[ridge, 0].mean() if ridge.any() else foot.centre_x
         x = np.polyval(np.polyfit(at, x, 1), at)  # one straight throat
         y = foot.heel_y - at * (foot.heel_y - foot.toe_y)
         half = 0.0095 + 0.0045 * (LACE_ROWS[0] - at) / (LACE_ROWS[0] - LACE_ROWS[1])
@@ -528,6 +607,12 @@ def _sheet(surface: _Surface, xy: np.ndarray, lift: float) -> Mesh | None:
     return Mesh(grid.reshape(-1, 3).astype(np.float32), faces.astype(np.int32))
 
 
+# The tongue's and facings' share of their atlas row: above the stitch low on the upper
+# (UPPER_STITCH_V, at 0.14 of the row), which, over all the row, ran across their front
+# ends by the lowest eyelets as a pale dashed line.
+LACING_BAND = (0.3, 0.95)
+
+
 def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> list[Piece]:
     """The lacing on an upper: a tongue, the quarters' facings with their eyelets, and the
     lace criss-crossing between them, one strip from bow to bow (``lace``)."""
@@ -546,7 +631,7 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         v = tongue.vertices.copy()
         v[:, 2] = np.minimum(v[:, 2], _top_eyelets_z(surface, plan) + TONGUE_OVER)
         tongue = Mesh(v, tongue.faces)
-        pieces.append(bound(body, _planar_uvs(tongue, "upper"), faces))
+        pieces.append(bound(body, _planar_uvs(tongue, "upper", LACING_BAND), faces))
     facings = []
     for side in (-1, 1):
         across = [half - 0.005, half + 0.002, half + 0.009]
@@ -555,11 +640,142 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         if sheet is not None:
             facings.append(sheet)
     if facings:
-        pieces.append(bound(body, _planar_uvs(_merge(facings), style.facings), faces))
+        facing_uvs = _planar_uvs(_merge(facings), style.facings, LACING_BAND)
+        pieces.append(bound(body, facing_uvs, faces))
     eyelets = [_disc(surface, xy, 0.0024) for side in (-1, 1) for xy in plan.eyelets(side)]
     pieces.append(bound(body, _planar_uvs(_merge(eyelets), "trim"), faces))
-    pieces.append(bound(body, _planar_uvs(lace(surface, plan), "laces"), faces))
+    shaft = _shaft_rows(foot, top, plan, surface)
+    pieces.append(bound(body, _planar_uvs(lace(surface, plan, shaft is None), "laces"), faces))
+    if shaft is not None:
+        pieces += shaft_lacing(body, surface, plan, shaft, style)
     return pieces
+
+
+# A boot's lacing goes on up the front of its shaft: rows SHAFT_STEP m apart from the
+# instep's top eyelets to SHAFT_TOP m under the collar, the throat's half-width there
+# widening by SHAFT_SPREAD; facings up it, the bow at the top. Laced only
+# over the instep, a boot's shaft stood closed and bare up the front of the ankle.
+SHAFT_STEP = 0.02
+SHAFT_TOP = 0.014
+SHAFT_SPREAD = 0.002
+
+
+@dataclass(frozen=True)
+class ShaftRows:
+    """Where a boot's lacing runs up its shaft: rows at heights ``z`` (K,) (the first the
+    instep's top eyelets), the throat's middle ``x`` (K,) and half-width ``half`` (K,)."""
+
+    z: np.ndarray
+    x: np.ndarray
+    half: np.ndarray
+
+    def eyelets(self, side: int) -> np.ndarray:
+        """(K, 2) xz of the eyelets on one side (-1 or +1)."""
+        return np.column_stack([self.x + side * self.half, self.z])
+
+
+def _shaft_rows(foot: Foot, top: Piece, plan: Lacing, surface: _Surface) -> ShaftRows | None:
+    """The rows up a boot's shaft (None for a low shoe: no shaft above the lacing)."""
+    v = top.mesh.vertices.astype(np.float64)
+    start = _top_eyelets_z(surface, plan) - EYELET_LIFT
+    collar = float(v[:, 2].max())
+    count = int((collar - SHAFT_TOP - start) // SHAFT_STEP)
+    if count < 1:
+        return None
+    z = start + SHAFT_STEP * np.arange(count + 1)
+    # The throat's middle: the instep's at the bottom, the shin's front (its foremost
+    # vertices) at the top.
+    x = np.empty(len(z))
+    for k, zk in enumerate(z):
+        band = v[np.abs(v[:, 2] - zk) < 0.006]
+        front = band[band[:, 1] < band[:, 1].min() + 0.004]
+        x[k] = front[:, 0].mean()
+    x[0] = plan.x[-1]
+    x = np.polyval(np.polyfit(z, x, 1), z)  # one straight line up the shin
+    x += (plan.x[-1] - x[0]) * np.linspace(1, 0, len(z))  # from the instep's top pair
+    half = plan.half[-1] + SHAFT_SPREAD * np.linspace(0, 1, len(z))
+    return ShaftRows(z, x, half)
+
+
+def _front(surface: _Surface, xz: np.ndarray, lift: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``lift`` m out of the upper's front at xz (N, 2) (rays from in front along
+    +y, the way the body faces), and the normals there."""
+    y = surface.v[:, 1].min() - 0.05
+    origins = np.column_stack([xz[:, 0], np.full(len(xz), y), xz[:, 1]])
+    points, normal, found = surface.hit(origins, (0.0, 1.0, 0.0))
+    if not found.all():  # past the shaft's edge (over the collar): as far back as the rest
+        index = np.arange(len(xz))
+        points[~found, 1] = np.interp(index[~found], index[found], points[found, 1])
+        normal[~found] = (0.0, -1.0, 0.0)
+    return points + lift * normal, normal
+
+
+def shaft_lacing(body: AuthoringBody, surface: _Surface, plan: Lacing, rows: ShaftRows,
+                 style: Style = SHOE) -> list[Piece]:  # fmt: skip
+    """A boot's lacing up its shaft's front (``ShaftRows``): a facing either side with
+    eyelets, and the lace's two ends criss-crossing on up from the instep's top eyelets to
+    a bow under the collar. (No tongue up the shaft: the shaft's own leather under the
+    lace reads as one, a millimetre lower, for a fifth of the lacing's triangles.)"""
+    faces = body.group_faces("helper-tights")
+    z = np.linspace(rows.z[0] - 0.004, rows.z[-1] + 0.01, 2 * len(rows.z))  # ~1 cm apart
+    x = np.interp(z, rows.z, rows.x)
+    half = np.interp(z, rows.z, rows.half)
+
+    def sheet(across: np.ndarray, lift: float) -> Mesh:  # a grid up the shaft's front
+        xz = np.stack([np.column_stack([x + a, z]) for a in across.T], 1)  # (R, C, 2)
+        points, _ = _front(surface, xz.reshape(-1, 2), lift)
+        r, c = xz.shape[:2]
+        idx = np.arange(r * c).reshape(r, c)
+        quads = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1)
+        return Mesh(points.astype(np.float32), quads.reshape(-1, 4).astype(np.int32))
+
+    facings = [sheet(side * (half[:, None] + np.array([[-0.005, 0.009]])), FACING_LIFT)
+               for side in (-1, 1)]  # fmt: skip
+    eyelets = [_front_disc(surface, xz, 0.0024) for side in (-1, 1)
+               for xz in rows.eyelets(side)[1:]]  # fmt: skip
+    return [
+        bound(body, _planar_uvs(_merge(facings), style.facings, LACING_BAND), faces),
+        bound(body, _planar_uvs(_merge(eyelets), "trim"), faces),
+        bound(body, _planar_uvs(_shaft_lace(surface, rows), "laces"), faces),
+    ]
+
+
+def _front_disc(surface: _Surface, xz: np.ndarray, radius: float) -> Mesh:
+    """An eyelet on the shaft's front: a hexagon ``radius`` m round xz, EYELET_LIFT out."""
+    angle = np.linspace(0, 2 * np.pi, 6, endpoint=False)
+    ring = xz + radius * np.column_stack([np.cos(angle), np.sin(angle)])
+    points, _ = _front(surface, ring, EYELET_LIFT)
+    faces = [[0, 3, 2, 1], [0, 5, 4, 3]]  # facing forward (-y)
+    return Mesh(points.astype(np.float32), np.array(faces, np.int32))
+
+
+def _shaft_lace(surface: _Surface, rows: ShaftRows) -> Mesh:
+    """The lace's two ends on up the shaft from the instep's top eyelets, crossing between
+    every pair of rows (the one from the right over), to a knot over the top pair and a
+    bow lying on the shaft's front: two strips."""
+    left, right = rows.eyelets(-1), rows.eyelets(1)
+    k = len(rows.z)
+    a_ends = [left[i] if i % 2 == 0 else right[i] for i in range(k)]
+    b_ends = [right[i] if i % 2 == 0 else left[i] for i in range(k)]
+    knot = np.array([rows.x[-1], rows.z[-1] + 0.005])
+    # The bow's loops and tails in xz: _bow's xy, its tails (towards the toes) hanging down.
+    first, second = _bow(knot, rows.half[-1])
+    strips = []
+    for ends, rise, loop in ((a_ends, 0.0003, first[::-1]), (b_ends, 0.0012, second)):
+        path, lift = [], []
+        for a, b in zip(ends[:-1], ends[1:], strict=True):
+            s = np.linspace(0, 1, 2, endpoint=False)
+            path.extend(a + s[:, None] * (b - a))
+            lift.extend(LACE_LIFT + rise * np.sin(np.pi * s))
+        s = np.linspace(0, 1, 3, endpoint=False)
+        path.extend(ends[-1] + s[:, None] * (knot - ends[-1]))
+        lift.extend([LACE_LIFT + 0.0008] * 3)
+        path.extend(loop)
+        lift.extend([LACE_LIFT + 0.0015] * len(loop))
+        points, normal = _front(surface, np.asarray(path), 0.0)
+        strips.append(_ribbon(points + np.asarray(lift)[:, None] * normal, normal,
+                              LACE_WIDTH, 0.0007))  # fmt: skip
+    return _merge(strips)
 
 
 def _top_eyelets_z(surface: _Surface, plan: Lacing) -> float:
@@ -577,11 +793,12 @@ def _disc(surface: _Surface, xy: np.ndarray, radius: float) -> Mesh:
     return Mesh(points.astype(np.float32), np.array(faces, np.int32))
 
 
-def lace(surface: _Surface, plan: Lacing) -> Mesh:
+def lace(surface: _Surface, plan: Lacing, bow: bool = True) -> Mesh:
     """One lace: straight across the lowest eyelets, then each end up to the next eyelet on
     the far side (criss-cross: the two ends cross between every pair of rows, the end
     coming from the right over the one from the left), up to a knot above the top pair,
-    tied in a bow (two loops and two tails)."""
+    tied in a bow (two loops and two tails); without ``bow`` its ends stop at the top pair
+    (a boot's lace goes on up the shaft: ``shaft_lacing``)."""
     left, right = plan.eyelets(-1), plan.eyelets(1)
     k = len(plan.y)
     # The path through the eyelets: L(K-1) ... R1, L0 | R0, L1, R2 ... (one strip).
@@ -595,19 +812,22 @@ def lace(surface: _Surface, plan: Lacing) -> Mesh:
         path.extend(a + s[:, None] * (b - a))
         lift.extend(LACE_LIFT + rise * np.sin(np.pi * s))
 
-    bow = _bow(knot, plan.half[-1])
-    for a, b in zip(bow[0][:-1], bow[0][1:], strict=True):  # tail, loops, back to the knot
-        run(a, b, 0.0015, 1)
-    run(knot, up_a[-1], 0.0008, 3)
+    loops = _bow(knot, plan.half[-1])
+    if bow:
+        for a, b in zip(loops[0][:-1], loops[0][1:], strict=True):  # tail, loop, to the knot
+            run(a, b, 0.0015, 1)
+        run(knot, up_a[-1], 0.0008, 3)
     for a, b in zip(up_a[::-1][:-1], up_a[::-1][1:], strict=True):  # down one end
         run(a, b, 0.0003)
     run(left[0], right[0], 0.0006)  # across the lowest pair
     for a, b in zip(up_b[:-1], up_b[1:], strict=True):  # up the other, over the first
         run(a, b, 0.0012)
-    run(up_b[-1], knot, 0.0008, 3)
-    for a, b in zip(bow[1][:-1], bow[1][1:], strict=True):
-        run(a, b, 0.0015, 1)
-    path.append(bow[1][-1])
+    if bow:
+        run(up_b[-1], knot, 0.0008, 3)
+        for a, b in zip(loops[1][:-1], loops[1][1:], strict=True):
+            run(a, b, 0.0015, 1)
+    end = loops[1][-1] if bow else up_b[-1]
+    path.append(end)
     lift.append(LACE_LIFT)
     xy = np.asarray(path)
     points, normal, found = surface.over(xy, 0.0)
@@ -720,8 +940,10 @@ def capped(body: AuthoringBody, foot: Foot, top: Piece) -> tuple[Piece, Piece]:
     # The throat opens to just over the top eyelets: the upper ran on up the front of the
     # ankle, a flap standing over the laces and the tongue.
     corners = v[top.mesh.faces]
-    line = _top_eyelets_z(_Surface(top.mesh), _lacing(foot, top)) + THROAT_OVER
-    keep &= ~((foot.along(corners.mean(axis=1)) > 0.42) & (corners[..., 2].max(axis=1) > line))
+    surface, plan = _Surface(top.mesh), _lacing(foot, top)
+    line = _top_eyelets_z(surface, plan) + THROAT_OVER
+    if _shaft_rows(foot, top, plan, surface) is None:  # a boot's is laced on up the shaft
+        keep &= ~((foot.along(corners.mean(axis=1)) > 0.42) & (corners[..., 2].max(axis=1) > line))
     seen = bound(body, top.mesh.subset(np.flatnonzero(keep)), body.group_faces("helper-tights"))
     return seen, cap
 
@@ -740,10 +962,15 @@ def sneakers(body: AuthoringBody) -> Piece:
 # shell, the vamp domed, the toe a ball, the sides bulging over a pinched bottom edge.
 WALL = 0.011
 ROLL = 0.75
-TOE_BOX = 0.013  # m the toe box reaches past the toes
+TOE_BOX = 0.0125  # m the outline reaches past the toes (the cap faired: ~13; 16 read long)
 TAPER = 0.3  # how much narrower the toe box's tip is than the toes' spread
 TOE_EASE = 0.003  # m over the toes (the instep has EASE)
-TOE_TIP = 0.06  # the toe box's tip: this fraction of the foot's length over the ground
+# The toe box's front in profile: its top comes down from over the toes in a curve to
+# NOSE m over the wall at its tip, where the wall is TOE_WALL x WALL high, and the roll
+# over onto the top rounds it (it ran down to a low tip 15 mm over the ground, under the
+# wall's top, with the toe spring rising to meet it: a beak).
+NOSE = 0.0055
+TOE_WALL = 0.3
 VAMP = (0.66, 0.97)  # along the foot: the vamp's straight run, from the throat to the toe
 SHAPED_TO = (0.07, 0.1)  # m above the ground: shaped fully below, not at all above (a boot)
 
@@ -783,15 +1010,12 @@ class _Last:
         toe = float(np.interp(b, self.t, top))  # over the toes' tips
         line = ha + (toe - ha) * (self.t - a) / (b - a)
         top = np.where(self.t >= a, np.maximum(line, np.where(self.t <= 1.0, top, -1)), top)
-        # Past the toes the vamp's line runs on down, steepening, to a low tip TOE_TIP x
-        # the foot's length over the ground (it ran on at twice the vamp's slope from
-        # higher over the toes: a tall, square front).
-        reach = 1.0 + TOE_BOX / (foot.heel_y - foot.toe_y)
-        tip = foot.ground + TOE_TIP * (foot.heel_y - foot.toe_y)
-        u = np.clip((self.t - b) / (reach - b), 0, 1)
-        slope = (ha - toe) / (b - a)
-        nose = toe - slope * (self.t - b) * (1 + 1.5 * u)
-        top = np.where(self.t > b, np.maximum(np.minimum(top, nose), tip), top)
+        # Past the toes the vamp's line runs on, curving down to a round nose (``_nose``).
+        reach = float(foot.along(np.column_stack([self.outline, np.zeros(len(self.outline))
+                                                  ])).max())  # fmt: skip
+        front = self.wall(np.array([reach]))[0] + NOSE
+        nose = _nose(self.t, b, reach, toe, (ha - toe) / (b - a), front)
+        top = np.where(self.t > b, np.maximum(np.minimum(top, nose), front), top)
         self.over = over
         # Behind the throat the counter and quarters stand up to the topline, no top.
         self.top = np.maximum(top, 0.3 * np.clip((0.4 - self.t) / 0.1, 0, 1))
@@ -801,12 +1025,18 @@ class _Last:
         """(N,) z of the last's bottom edge: EDGE above the ground, curling up at the toe."""
         return self.foot.ground + EDGE + SPRING * np.clip((t - 0.84) / 0.2, 0, 1) ** 2
 
+    def wall(self, t: np.ndarray) -> np.ndarray:
+        """(N,) z of the top of the last's upright wall: WALL over its bottom, lower round
+        the toe (TOE_WALL x at its tip), where the front rolls over from low down."""
+        lower = (1 - TOE_WALL) * np.clip((t - 0.9) / 0.15, 0, 1)
+        return self.bottom(t) + WALL * (1 - lower)
+
     def inside(self, q: np.ndarray) -> np.ndarray:
         """(N,) bool: points (N, 3) inside the last."""
         t = self.foot.along(q)
         depth = _depth_in(self.outline, q[:, :2])  # m inside the outline in plan (< 0 out)
         bottom = self.bottom(t)
-        wall = bottom + WALL * (1 - 0.5 * np.clip((t - 0.85) / 0.2, 0, 1))  # lower at the toe
+        wall = self.wall(t)
         height = np.interp(t, self.t, self.top) - wall
         radius = np.clip(np.minimum(ROLL * height, 0.9 * np.interp(t, self.t, self.half)),
                          0.004, None)  # fmt: skip
@@ -837,6 +1067,19 @@ class _Last:
         z = points[:, 2] - foot.ground
         weight = np.clip((SHAPED_TO[1] - z) / (SHAPED_TO[1] - SHAPED_TO[0]), 0, 1)[:, None]
         return points + weight * (shaped - points)
+
+
+def _nose(t: np.ndarray, b: float, reach: float, toe: float, slope: float,
+          front: float) -> np.ndarray:  # fmt: skip
+    """(N,) z of the toe box's top at ``t`` past ``b`` (over the toes, at ``toe`` m and
+    coming down ``slope`` m per unit of t): a cubic leaving the vamp's line smoothly and
+    reaching ``front`` at the tip (``reach``) three times as steep."""
+    span = reach - b
+    u = np.clip((t - b) / span, 0, 1)
+    m0, m1 = -slope * span, -3 * slope * span  # slopes per unit of u
+    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+    return h00 * toe + h10 * m0 + h01 * front + h11 * m1
 
 
 def _offset_outline(hull: np.ndarray, ease: float, foot: Foot, n: int = 96) -> np.ndarray:
@@ -987,6 +1230,7 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
         stitches = [v for i, v in enumerate(stitches) if np.all(np.abs(pixel[:i] - pixel[i]) > 3)]
         m = fabrics.atlas(spec.name, [
             (*ROWS["upper"], upper, upper_colour),
+            (*ROWS["vamp"], upper, upper_colour),
             (*ROWS["trim"], trim_fabric, trim_colour),
             (*ROWS["cap"], upper, cap_colour or upper_colour),
             (*ROWS["sole"], sole, sole_colour),
@@ -994,11 +1238,12 @@ def look(upper: str, upper_colour: str, sole: str, sole_colour: str, *,
         ], size, stitches=tuple(stitches))  # fmt: skip
         if band is not None:
             _moulded_band(m, fabrics.rgb(band), size)
-        for row in ("upper", "cap"):
+        for row in ("upper", "vamp", "cap"):
             if upper in LEATHERS:
                 _grained(m, ROWS[row], size, GRAIN_STRETCH[row])
             else:
-                _knit_mesh(m, ROWS[row], size)
+                _knit_mesh(m, ROWS[row], size, KNIT_STRETCH.get(row, 1.0))
+        _creased(m, size, 1.0 if upper in LEATHERS else 0.6)
         return m
 
     return material
@@ -1036,21 +1281,26 @@ def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], cell: int,
     return top + (c + (d - c) * fx[None] - top) * fy[:, None]
 
 
-def _bumped(normal: np.ndarray, height: np.ndarray, slope: float) -> np.ndarray:
-    """(H, W, 3) uint8 tangent-space normals tilted by the gradient of ``height`` (H, W)."""
+def _bumped(normal: np.ndarray, height: np.ndarray, slope: float,
+            aspect: float = 1.0) -> np.ndarray:  # fmt: skip
+    """(H, W, 3) uint8 tangent-space normals tilted by the gradient of ``height`` (H, W);
+    ``aspect``: a texel's width over its height on the garment (its slope down the rows is
+    per that much less surface)."""
     n = normal.astype(np.float32) / 127.5 - 1
     gy, gx = np.gradient(height)
     n[..., 0] -= slope * gx
-    n[..., 1] += slope * gy  # image rows run down the texture, v up
+    n[..., 1] += slope * aspect * gy  # image rows run down the texture, v up
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     return np.clip((n + 1) * 127.5, 0, 255).astype(np.uint8)
 
 
 # How much taller than wide a grain cell is in each row's texels, so that it is round on
 # the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
-# (~0.25 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm).
-# Square in texels, the pebble was streaked round the quarters and along the cap.
-GRAIN_STRETCH = {"upper": 2.4, "cap": 0.4}
+# (~0.33 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm),
+# the vamp's v along the foot (~0.8 mm) and its u round it (~0.13 mm). Square in texels,
+# the pebble was streaked round the quarters and along the cap.
+GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.4}
+KNIT_STRETCH = {"vamp": 0.16}  # a sneaker's mesh cells, the same way
 
 
 def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
@@ -1068,27 +1318,70 @@ def _grained(m: Material, span: tuple[float, float], size: int, stretch: float =
     pebble = np.abs(_smooth_noise(rng, shape, cell, stretch)) + 0.5 * np.abs(
         _smooth_noise(rng, shape, 2 * cell, stretch))
     height = -pebble  # pores and pebble valleys between raised grains
-    normal[rows] = _bumped(normal[rows], height, GRAIN)
+    # The vamp's texels are 6 times longer along the foot than round it: per texel, its
+    # grain's slopes along the foot were 6 times too steep (streaks across the vamp).
+    normal[rows] = _bumped(normal[rows], height, GRAIN, min(1.0, stretch) if span == ROWS["vamp"]
+                           else 1.0)  # fmt: skip
     patches = _smooth_noise(rng, shape, max(8, size // 24))
     r = rough[rows].astype(np.float32) + 255 * (0.1 + 0.07 * patches + 0.08 * pebble)
     rough[rows] = np.clip(r, 0, 255).astype(np.uint8)
 
 
-def _knit_mesh(m: Material, span: tuple[float, float], size: int) -> None:
+def _knit_mesh(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
     """A sneaker's textile upper in one atlas row, in place: an engineered mesh, open
-    cells in a diamond lattice, each a shade darker and sunk in the normal map."""
+    cells in a diamond lattice, each a shade darker and sunk in the normal map; ``stretch``:
+    how much taller than wide a cell is in texels (square on the shoe)."""
     image, normal, rough = m.base_color_texture, m.normal_texture, m.roughness_texture
     assert image is not None and normal is not None and rough is not None
     rows = _rows(span, size)
     h, w = image[rows].shape[:2]
     pitch = max(4, size // 170)
     y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    if stretch < 1:  # cells shorter down the rows than across: as wide as they are tall
+        pitch, x = max(2, int(round(pitch * stretch))), x * stretch
     a = (x + y) * np.pi / pitch
     b = (x - y) * np.pi / pitch
     cells = np.clip(np.sin(a) * np.sin(b), 0, None) ** 0.5  # 1 in a cell's middle, 0 on ribs
     image[rows] = (image[rows].astype(np.float32) * (1 - 0.22 * cells[..., None])).astype(np.uint8)
     normal[rows] = _bumped(normal[rows], -cells, 0.6)
     rough[rows] = np.clip(rough[rows].astype(np.float32) + 30 * cells, 0, 255).astype(np.uint8)
+
+
+# Flex creases across the vamp: at these fractions of the foot's length (the ball's
+# joints, the big toe's further forward: CREASE_TILT over the vamp's width), each an arc
+# across the instep whose ends bend back towards the heel (CREASE_BEND) down the sides,
+# a narrow valley wavering along it, some shallower or broken, fading out low on the
+# sides, with a soft ridge before it.
+CREASES = (0.67, 0.7, 0.73, 0.755)
+CREASE_TILT = 0.03
+CREASE_BEND = 0.05
+CREASE_SLOPE = 1.4  # the normal map's tilt per unit of the crease's depth per texel
+
+
+def _creased(m: Material, size: int, strength: float = 1.0) -> None:
+    """Flex creases in the vamp row's normal map (and a shade darker in their valleys),
+    in place (``CREASES``; u in the row runs round the foot, v along it: ``_vamp_uvs``)."""
+    image, normal = m.base_color_texture, m.normal_texture
+    assert image is not None and normal is not None
+    rows = _rows(ROWS["vamp"], size)
+    h, w = normal[rows].shape[:2]
+    y = np.arange(h, dtype=np.float64)[:, None]  # texel rows down the vamp row
+    u = np.clip((np.arange(w) / w - 0.02) / 0.96, 0, 1)  # 0 low inside, 1 low outside
+    side = np.abs(2 * u - 1)  # 0 over the instep, 1 low on either side
+    across = np.clip(1.25 - 1.25 * side, 0, 1) ** 1.5  # fades out down the sides
+    rng = np.random.default_rng(14)
+    height = np.zeros((h, w))
+    for t in CREASES:
+        line = t + CREASE_TILT * (0.5 - u) - CREASE_BEND * side**2
+        waver = 1.2 * _smooth_noise(rng, (1, w), max(8, w // 10))[0]  # texels at 1024
+        centre = (1 - np.array([vamp_v(x) for x in line])) * size - rows.start
+        d = (y - centre[None]) * 1024 / size - waver[None]  # texels at 1024 off the line
+        depth = np.clip(0.35 + 0.9 * _smooth_noise(rng, (1, w), max(8, w // 5))[0], 0, 1)
+        valley = np.exp(-((d / 1.3) ** 2)) - 0.3 * np.exp(-(((d + 2.2) / 1.8) ** 2))
+        height -= depth * across * valley
+    normal[rows] = _bumped(normal[rows], height * strength * size / 1024, CREASE_SLOPE)
+    shade = 1 - 0.08 * strength * np.clip(-height, 0, 1)
+    image[rows] = (image[rows].astype(np.float32) * shade[..., None]).astype(np.uint8)
 
 
 def _moulded_band(m: Material, colour: np.ndarray, size: int) -> None:
@@ -1157,9 +1450,10 @@ def _facing_out(mesh: Mesh, inside: np.ndarray) -> Mesh:
     return Mesh(mesh.vertices, faces)
 
 
-def _planar_uvs(mesh: Mesh, row: str) -> Mesh:
+def _planar_uvs(mesh: Mesh, row: str, band: tuple[float, float] = (0.05, 0.95)) -> Mesh:
     """Per-corner UVs inside the atlas row: the piece seen from its side (y, z) for the
-    upper, toe cap and sole, from above (x, y) for laces, scaled to fit the row."""
+    upper, toe cap and sole, from above (x, y) for laces, scaled to fit the row's ``band``
+    (fractions of its height)."""
     v0, v1 = ROWS[row]
     p = mesh.vertices[mesh.faces].astype(np.float64)  # (F, C, 3)
     if row == "laces":
@@ -1173,6 +1467,7 @@ def _planar_uvs(mesh: Mesh, row: str) -> Mesh:
         u = np.where(wrapped, u + 1.0, u) * 0.5  # [0, 1): faces across the seam stay whole
     u = (u - u.min()) / max(float(np.ptp(u)), 1e-9)
     w = (w - w.min()) / max(float(np.ptp(w)), 1e-9)
-    uvs = np.stack([0.02 + 0.96 * u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1).reshape(-1, 2)
+    w = band[0] + (band[1] - band[0]) * w
+    uvs = np.stack([0.02 + 0.96 * u, v0 + (v1 - v0) * w], -1).reshape(-1, 2)
     face_uvs = np.arange(mesh.faces.size, dtype=np.int32).reshape(mesh.faces.shape)
     return Mesh(mesh.vertices, mesh.faces, uvs.astype(np.float32), face_uvs)
