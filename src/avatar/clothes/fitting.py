@@ -26,7 +26,7 @@ from avatar.geometry import collision
 from avatar.geometry.shell import Shell, extrude, solidify
 from avatar.io.mhw import BoneWeights
 from avatar.material import Material
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, face_normals
 from avatar.rig.skinning import SkinWeights
 
 CLEARANCE = 0.002  # m between skin and a garment's inside
@@ -82,6 +82,17 @@ class Garment:
         return []
 
     @cached_property
+    def untangling(self) -> tuple:
+        """(first (P,), second (P,)): the two faces of each shared edge; (N, N) sparse
+        average of each vertex with its edge neighbours (``untangled``)."""
+        from avatar.clothes.authoring import face_pairs
+        from avatar.clothes.outfit import _spread_matrix
+
+        n = len(self.mesh.vertices)
+        return (*face_pairs(self.mesh.faces),
+                _spread_matrix([self.mesh.faces], np.arange(n), 1))  # fmt: skip
+
+    @cached_property
     def shell(self) -> Shell | None:
         """The solidified topology (computed once), or None without thickness."""
         return solidify(self.mesh) if self.thickness > 0 else None
@@ -128,6 +139,7 @@ class Pose(collision.PosedBody):
 
         Returns (points (N, 3) float32, query at the final positions).
         """
+        bound = points
         q = self.query_near(points)
         need = np.full(len(points), garment.clearance, np.float32)
         for _ in range(iterations):
@@ -139,6 +151,11 @@ class Pose(collision.PosedBody):
             points = points.copy()
             points[short] = collision.push_out(points[short], q.take(short), need[short])
             q = q.put(short, self.query(points[short], k=4))
+        points, moved = untangled(bound, points, garment)
+        if len(moved):
+            q = q.put(moved, self.query(points[moved], k=4))
+            need = np.broadcast_to(need, q.distance.shape).copy()
+            need[moved] = np.minimum(need[moved], np.maximum(q.distance[moved], garment.clearance))
         self._raise_floor(q, garment.thickness)
         self.last_need = np.broadcast_to(need, q.distance.shape).astype(np.float32)
         return points, q
@@ -155,7 +172,11 @@ class Pose(collision.PosedBody):
         moved = np.flatnonzero(np.any(points != pushed, axis=1))
         if len(moved) and np.any(self.query(points[moved], k=4).distance < 0):
             return self.resolve(fitted, garment)  # squeezed between parts: the full search
+        points, moved = untangled(fitted, points, garment)
         q = self.anchored(points, tri, bary)
+        if len(moved):  # frames keep the clearance the untangled cloth has
+            need = need.copy()
+            need[moved] = np.minimum(need[moved], np.maximum(q.distance[moved], garment.clearance))
         self._raise_floor(q, garment.thickness)
         self.last_need = need.astype(np.float32)
         return points, q
@@ -167,6 +188,40 @@ class Pose(collision.PosedBody):
         top = q.distance + np.float32(thickness)
         near = q.distance < FLOOR_REACH
         np.maximum.at(self.floor, q.vertex[near], top[near])
+
+
+FOLDED = -0.2  # cos between neighbouring faces below which cloth counts as folded over
+UNTANGLE_ROUNDS = 12
+
+
+def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
+    """(points (N, 3) float32, (M,) the vertices moved): ``points``, pushed out from the
+    fold-free ``bound`` (N, 3), with the pushes round any faces that fold over (more
+    than ~100 degrees against a neighbour) averaged with their neighbours' until none
+    does. In a crease tighter than a layer's need (the armpit: a jacket over a T-shirt
+    asks 2.4 cm where the binding left it 1.3 cm from arm and chest) neighbouring points
+    were pushed along their own skin's normals the opposite ways, some towards the chest,
+    some towards the arm: they crossed and 12 face pairs folded under a man's arms (a
+    crumpled armpit, its stitching zig-zagging)."""
+    first, second, spread = garment.untangling
+    faces = garment.mesh.faces
+    points = np.asarray(points, np.float32)
+    move = (points - bound).astype(np.float64)
+    touched = np.zeros(len(points), bool)
+    for _ in range(UNTANGLE_ROUNDS):
+        n = face_normals(bound + move, faces)
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+        folded = np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
+        if not folded.any():
+            break
+        near = np.zeros(len(points), np.float64)
+        near[faces[np.concatenate([first[folded], second[folded]])].ravel()] = 1.0
+        near = (spread @ near) > 0  # and the ring round them
+        move[near] = (spread @ move)[near]
+        touched |= near
+    if not touched.any():
+        return points, np.zeros(0, np.intp)
+    return (bound + move).astype(np.float32), np.flatnonzero(touched)
 
 
 def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None) -> SkinWeights:
