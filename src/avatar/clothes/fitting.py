@@ -196,8 +196,8 @@ UNTANGLE_ROUNDS = 12
 
 def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
     """(points (N, 3) float32, (M,) the vertices moved): ``points``, pushed out from the
-    fold-free ``bound`` (N, 3), with the pushes round any faces that fold over (more
-    than ~100 degrees against a neighbour) averaged with their neighbours' until none
+    ``bound`` (N, 3), with the pushes round any faces the pushes fold over (more than
+    ~100 degrees against a neighbour; not in ``bound``) averaged with their neighbours' until none
     does. In a crease tighter than a layer's need (the armpit: a jacket over a T-shirt
     asks 2.4 cm where the binding left it 1.3 cm from arm and chest) neighbouring points
     were pushed along their own skin's normals the opposite ways, some towards the chest,
@@ -208,10 +208,15 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
     points = np.asarray(points, np.float32)
     move = (points - bound).astype(np.float64)
     touched = np.zeros(len(points), bool)
-    for _ in range(UNTANGLE_ROUNDS):
-        n = face_normals(bound + move, faces)
+
+    def folds(v):
+        n = face_normals(v, faces)
         n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
-        folded = np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
+        return np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
+
+    was = folds(bound.astype(np.float64))  # (bands turned over at a hem fold by design)
+    for _ in range(UNTANGLE_ROUNDS):
+        folded = folds(bound + move) & ~was
         if not folded.any():
             break
         near = np.zeros(len(points), np.float64)
