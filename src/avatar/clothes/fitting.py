@@ -194,7 +194,8 @@ FOLDED = -0.2  # cos between neighbouring faces below which cloth counts as fold
 UNTANGLE_ROUNDS = 12
 
 
-def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
+def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment,
+              like: np.ndarray | None = None) -> tuple:  # fmt: skip
     """(points (N, 3) float32, (M,) the vertices moved): ``points``, pushed out from the
     ``bound`` (N, 3), with the pushes round any faces the pushes fold over (more than
     ~100 degrees against a neighbour; not in ``bound``) averaged with their neighbours' until none
@@ -202,7 +203,8 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
     asks 2.4 cm where the binding left it 1.3 cm from arm and chest) neighbouring points
     were pushed along their own skin's normals the opposite ways, some towards the chest,
     some towards the arm: they crossed and 12 face pairs folded under a man's arms (a
-    crumpled armpit, its stitching zig-zagging)."""
+    crumpled armpit, its stitching zig-zagging). ``like``: the surface whose folds are
+    meant (default ``bound``)."""
     first, second, spread = garment.untangling
     faces = garment.mesh.faces
     points = np.asarray(points, np.float32)
@@ -214,7 +216,8 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment) -> tuple:
         n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
         return np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
 
-    was = folds(bound.astype(np.float64))  # (bands turned over at a hem fold by design)
+    # (bands turned over at a hem fold by design; like: (N, 3) the surface whose folds are)
+    was = folds((bound if like is None else like).astype(np.float64))
     for _ in range(UNTANGLE_ROUNDS):
         folded = folds(bound + move) & ~was
         if not folded.any():
@@ -304,11 +307,11 @@ def _anchors(pose: Pose, garment: Garment, q, mesh: Mesh) -> tuple:
     return (*inner, tri_o, bary_o, np.maximum(keep, 0).astype(np.float32), near_o), qo
 
 
-def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo) -> Mesh:
+def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo, garment: Garment) -> Mesh:
     """A shell's outer layer, grown along the body normal, checked against the whole body
     (in a fold it can reach the skin opposite); qo: its anchored query (``_anchors``)."""
     n = len(anchor[2])
-    outer = mesh.vertices[n:]
+    grown = outer = mesh.vertices[n:]
     outer = fixed = collision.push_out(outer, qo, anchor[6])
     outer = remote_contacts(pose, None, outer, anchor[6], anchor[7], qo.normal, 4)
     # Squeezed between two body parts there may be no room for the shell: it thins there.
@@ -316,6 +319,10 @@ def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo) -> Mesh:
     if len(moved):
         stuck = moved[pose.query(outer[moved], k=4).distance < 0]
         outer[stuck] = mesh.vertices[stuck]
+    # The outer layer is the one seen: where it folds over and the inner layer does not,
+    # its pushes are shared (``untangled``; grown along the skin's normals, which turn
+    # through a crease, it folded under the arm where the inner layer did not).
+    outer = untangled(mesh.vertices[:n], outer, garment)[0]
     return mesh.with_vertices(np.concatenate([mesh.vertices[:n], outer]))
 
 
@@ -383,7 +390,7 @@ def _dress(
         anchor, qo = _anchors(pose, garment, q, mesh)
         anchors.append(anchor)
         if qo is not None:
-            mesh = _check_outer(pose, mesh, anchor, qo)
+            mesh = _check_outer(pose, mesh, anchor, qo, garment)
             fitted[-1] = replace(fitted[-1], mesh=mesh)
     return Outfit(fitted, surface, rests, ws, anchors, pose.vertices.copy())
 
