@@ -172,11 +172,13 @@ class Pose(collision.PosedBody):
         moved = np.flatnonzero(np.any(points != pushed, axis=1))
         if len(moved) and np.any(self.query(points[moved], k=4).distance < 0):
             return self.resolve(fitted, garment)  # squeezed between parts: the full search
-        points, moved = untangled(fitted, points, garment)
+        points, untangled_ = untangled(fitted, points, garment)
         q = self.anchored(points, tri, bary)
-        if len(moved):  # frames keep the clearance the untangled cloth has
+        kept = np.union1d(moved, untangled_)
+        if len(kept):  # frames keep the clearance the squeezed, untangled cloth has
+            exact = np.minimum(self.query(points[kept], k=4).distance, q.distance[kept])
             need = need.copy()
-            need[moved] = np.minimum(need[moved], np.maximum(q.distance[moved], garment.clearance))
+            need[kept] = np.minimum(need[kept], np.maximum(exact, garment.clearance))
         self._raise_floor(q, garment.thickness)
         self.last_need = need.astype(np.float32)
         return points, q
