@@ -218,10 +218,13 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment,
         n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
         return np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
 
-    # (bands turned over at a hem fold by design; like: (N, 3) the surface whose folds are)
-    was = folds((bound if like is None else like).astype(np.float64))
+    was = None  # (bands turned over at a hem fold by design; like: the surface whose folds are)
     for _ in range(UNTANGLE_ROUNDS):
-        folded = folds(bound + move) & ~was
+        folded = folds(bound + move)
+        if folded.any():
+            if was is None:
+                was = folds((bound if like is None else like).astype(np.float64))
+            folded &= ~was
         if not folded.any():
             break
         near = np.zeros(len(points), np.float64)
