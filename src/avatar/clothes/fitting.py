@@ -198,10 +198,10 @@ UNTANGLE_ROUNDS = 12
 
 def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment,
               like: np.ndarray | None = None) -> tuple:  # fmt: skip
-    """(points (N, 3) float32, (M,) the vertices moved): ``points``, pushed out from the
-    ``bound`` (N, 3), with the pushes round any faces the pushes fold over (more than
-    ~100 degrees against a neighbour; not in ``bound``) averaged with their neighbours' until none
-    does. In a crease tighter than a layer's need (the armpit: a jacket over a T-shirt
+    """(points (N, 3) float32, (M,) the vertices moved): ``points``, pushed out from
+    ``bound`` (N, 3), with the pushes round faces they fold over (more than ~100 degrees
+    against a neighbour, where ``bound`` does not) averaged with their neighbours' until
+    none does. In a crease tighter than a layer's need (the armpit: a jacket over a T-shirt
     asks 2.4 cm where the binding left it 1.3 cm from arm and chest) neighbouring points
     were pushed along their own skin's normals the opposite ways, some towards the chest,
     some towards the arm: they crossed and 12 face pairs folded under a man's arms (a
@@ -316,7 +316,7 @@ def _check_outer(pose: Pose, mesh: Mesh, anchor: tuple, qo, garment: Garment) ->
     """A shell's outer layer, grown along the body normal, checked against the whole body
     (in a fold it can reach the skin opposite); qo: its anchored query (``_anchors``)."""
     n = len(anchor[2])
-    grown = outer = mesh.vertices[n:]
+    outer = mesh.vertices[n:]
     outer = fixed = collision.push_out(outer, qo, anchor[6])
     outer = remote_contacts(pose, None, outer, anchor[6], anchor[7], qo.normal, 4)
     # Squeezed between two body parts there may be no room for the shell: it thins there.
