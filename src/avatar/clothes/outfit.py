@@ -388,7 +388,8 @@ def _swinging(g: FittedGarment, count: int) -> np.ndarray:
     return g.garment.mesh.vertices[:, 2] < below
 
 
-def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csc_matrix:
+def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray,
+                   passes: int = SPREAD_PASSES) -> csc_matrix:  # fmt: skip
     """(S, S) float32 ``SPREAD_PASSES`` averages of each shell row with its edge neighbours
     (faces: each shell's (F_i, C) faces as colliding rows; shell: (S,) those rows)."""
     n = len(shell)
@@ -407,7 +408,7 @@ def _spread_matrix(faces: list[np.ndarray], shell: np.ndarray) -> csc_matrix:
     step.data[:] = 1.0  # an edge shared by two faces counts once
     step = csr_matrix(step.multiply(1.0 / np.asarray(step.sum(axis=1))), dtype=np.float32)
     out = step
-    for _ in range(SPREAD_PASSES - 1):
+    for _ in range(passes - 1):
         out = out @ step
     return csc_matrix(out, dtype=np.float32)  # columns: the few pushed points' shares
 
