@@ -7,13 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from avatar.body.model import BodyModel
+from avatar.body.shaped import default_body
 from avatar.clothes import thumbnail
-from avatar.human import Human
 
 
 @pytest.fixture(scope="module")
 def human():
-    return Human({})
+    """The default body (the pictures' wearer)."""
+    return default_body(BodyModel.shared())
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +78,7 @@ def test_pictures_are_written_atomically_where_the_extension_looks(tmp_path, mon
     (tmp_path / "thumbnails").mkdir()
     older = tmp_path / "thumbnails" / "cap-32-0123456789ab.png"  # another version's picture
     older.write_bytes(b"old")
-    path = thumbnail.write_picture("cap", 32, human=human)
+    path = thumbnail.write_picture("cap", 32, body=human)
     assert path == thumbnail.picture_path("cap", 32) and path.parent == tmp_path / "thumbnails"
     from PIL import Image
 

@@ -90,9 +90,8 @@ def run_thumbnails(args: argparse.Namespace) -> int:
         for written in thumbnail.draw_missing(names, args.size):
             print(f"wrote {written}", flush=True)
         return 0
-    human = Human({})
     for name in names:
         path = Path(args.out) / f"{name}.png" if args.out else None
-        written = thumbnail.write_picture(name, args.size, path, human, args.folder or ())
+        written = thumbnail.write_picture(name, args.size, path, folders=args.folder or ())
         print(f"wrote {written}", flush=True)
     return 0

@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar.body.shaped import PART_GROUPS
+from avatar.body.model import BodyModel
+from avatar.body.shaped import PART_GROUPS, Body, default_body
 from avatar.clothes.fitting import FittedGarment
 from avatar.material import Material
 
@@ -59,14 +60,14 @@ def _code() -> str:
 
 
 def write_picture(name: str, size: int = SIZE, path: str | os.PathLike[str] | None = None,
-                  human=None, folders=()) -> Path:  # fmt: skip
+                  body: Body | None = None, folders=()) -> Path:  # fmt: skip
     """Draw item ``name``'s picture and write it as a PNG (atomically) at ``path`` (default
     ``picture_path``, where older code's pictures of the item are removed); returns the
     path."""
     from avatar.io import png
 
     out = Path(path) if path is not None else picture_path(name, size)
-    image = garment_picture(name, size, human, folders)
+    image = garment_picture(name, size, body, folders)
     out.parent.mkdir(parents=True, exist_ok=True)
     png.write(out, image)
     if path is None:  # older code's pictures of this item are not read again
@@ -81,28 +82,21 @@ def draw_missing(names: list[str] | None = None, size: int = SIZE) -> list[Path]
     returns the paths written. ``python -m avatar.clothes.thumbnail`` runs it: the Blender
     extension starts it as a separate process, which needs none of the CLI's extras."""
     from avatar.clothes import library
-    from avatar.human import Human
 
     names = names if names is not None else [e.name for e in library.builtin_entries()]
-    human, written = None, []
-    for name in names:
-        if not picture_path(name, size).is_file():
-            human = human or Human({})
-            written.append(write_picture(name, size, human=human))
-    return written
+    return [write_picture(name, size) for name in names if not picture_path(name, size).is_file()]
 
 
-def garment_picture(name: str, size: int = SIZE, human=None, folders=()) -> np.ndarray:
+def garment_picture(name: str, size: int = SIZE, body: Body | None = None,
+                    folders=()) -> np.ndarray:  # fmt: skip
     """(size, size, 4) uint8 picture of the library item ``name`` (found also in asset
-    ``folders``) worn by ``human`` (default: the default body, all macros 0.5). Raises as
+    ``folders``) worn by ``body`` (default: the default body, all macros 0.5). Raises as
     ``library.load_garment`` for a bad name."""
     from avatar.clothes import library
-    from avatar.human import Human
-
-    human = human or Human({})
-    garment = library.load_garment(name, folders, texture_size=256, model=human.body.model)
-    (fitted,) = library.dress(human.body, [garment])
-    return picture(fitted, human.body, size)
+    body = body or default_body(BodyModel.shared())
+    garment = library.load_garment(name, folders, texture_size=256, model=body.model)
+    (fitted,) = library.dress(body, [garment])
+    return picture(fitted, body, size)
 
 
 def picture(fitted: FittedGarment, body, size: int = 128) -> np.ndarray:
