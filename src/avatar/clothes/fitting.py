@@ -212,18 +212,13 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment,
     points = np.asarray(points, np.float32)
     move = (points - bound).astype(np.float64)
     touched = np.zeros(len(points), bool)
-
-    def folds(v):
-        n = face_normals(v, faces)
-        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
-        return np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
-
     was = None  # (bands turned over at a hem fold by design; like: the surface whose folds are)
     for _ in range(UNTANGLE_ROUNDS):
-        folded = folds(bound + move)
+        folded = _folds(bound + move, faces, first, second)
         if folded.any():
             if was is None:
-                was = folds((bound if like is None else like).astype(np.float64))
+                was = _folds((bound if like is None else like).astype(np.float64), faces,
+                             first, second)  # fmt: skip
             folded &= ~was
         if not folded.any():
             break
@@ -235,6 +230,13 @@ def untangled(bound: np.ndarray, points: np.ndarray, garment: Garment,
     if not touched.any():
         return points, np.zeros(0, np.intp)
     return (bound + move).astype(np.float32), np.flatnonzero(touched)
+
+
+def _folds(v: np.ndarray, faces: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """(P,) bool: faces ``first`` (P,) and ``second`` (P,) of ``v`` turned over each other."""
+    n = face_normals(v, faces)
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+    return np.einsum("nd,nd->n", n[first], n[second]) < FOLDED
 
 
 def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None) -> SkinWeights:
@@ -367,7 +369,7 @@ def _worn_by(body: Body, garment: Garment) -> Garment:
     if thickness == garment.thickness:
         return garment
     thin = replace(garment, thickness=thickness)
-    for key in ("anchor_cache", "weight_cache", "shell"):
+    for key in ("anchor_cache", "weight_cache", "shell", "untangling"):
         thin.__dict__[key] = getattr(garment, key)
     return thin
 
