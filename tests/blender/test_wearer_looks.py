@@ -9,6 +9,11 @@ import numpy as np
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 WORN = ["hair-short", "eyebrows", "moustache"]
+# How much lighter an old wearer's items render than a young one's: facial hair less, as
+# its dark shades are lifted (``looks.facial_hair.facial_lift``: x1.7 for dark hair) and
+# its grey held at ``FACIAL_GREY`` of the scalp's (a white beard read as cotton wool).
+# An item that did not grey at all stays near 1.
+GREYING = {"hair-short": 2.5, "eyebrows": 2.5, "moustache": 2.0}
 
 
 def _shown_luma(obj) -> float:
@@ -38,7 +43,7 @@ def test_created_characters_grey_with_age(empty_scene, assets):
                            location=(1, 0, 0))  # fmt: skip
     a, b = _lumas(young.root), _lumas(old.root)
     for name in WORN:
-        assert b[name] > 2.5 * a[name], (name, a[name], b[name])
+        assert b[name] > GREYING[name] * a[name], (name, a[name], b[name])
 
 
 def test_settling_an_age_change_greys_the_hair(empty_scene, assets):
@@ -50,7 +55,7 @@ def test_settling_an_age_change_greys_the_hair(empty_scene, assets):
     live.settle(built.root)
     after = _lumas(built.root)
     for name in WORN:
-        assert after[name] > 2.5 * before[name], (name, before[name], after[name])
+        assert after[name] > GREYING[name] * before[name], (name, before[name], after[name])
 
 
 def test_a_hair_colour_variant_carries_to_the_brows(empty_scene, assets):
