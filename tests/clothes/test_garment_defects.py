@@ -840,19 +840,25 @@ def test_tops_do_not_fold_under_the_arm(name):
     for v, faces, marks in ((piece.mesh.vertices, piece.mesh.faces, body.marks),
                             (fitted.mesh.vertices[:count], fitted.garment.mesh.faces,
                              AuthoringBody(human.body).marks)):  # fmt: skip
-        v = v.astype(np.float64)
-        centre = v[faces].mean(axis=1)
-        shoulder = marks.shoulder[:, 2].mean()
-        # (not the hood's roll lying on the back behind it)
-        under = ((np.abs(centre[:, 0]) > 0.1) & (np.abs(centre[:, 0]) < 0.26)
-                 & (np.abs(centre[:, 1] - marks.shoulder[:, 1].mean()) < 0.06)
-                 & (centre[:, 2] > shoulder - 0.25) & (centre[:, 2] < shoulder))  # fmt: skip
-        q = v[faces]
-        n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
-        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
-        a, b = _face_pairs(faces)
-        turn = np.einsum("nd,nd->n", n[a], n[b])
+        centre, under, a, _, turn = _under_arm_turns(v, faces, marks)
         assert (turn[under[a]] > -0.17).all(), centre[a[under[a] & (turn < -0.17)]]
+
+
+def _under_arm_turns(v: np.ndarray, faces: np.ndarray, marks) -> tuple:
+    """Face centres (F, 3), which lie under the arms (F,) bool (not the hood's roll lying
+    on the back behind them), and each pair of faces sharing an edge: its two faces (P,),
+    (P,) and the cosine between their normals (P,)."""
+    v = v.astype(np.float64)
+    centre = v[faces].mean(axis=1)
+    shoulder = marks.shoulder[:, 2].mean()
+    under = ((np.abs(centre[:, 0]) > 0.1) & (np.abs(centre[:, 0]) < 0.26)
+             & (np.abs(centre[:, 1] - marks.shoulder[:, 1].mean()) < 0.06)
+             & (centre[:, 2] > shoulder - 0.25) & (centre[:, 2] < shoulder))  # fmt: skip
+    q = v[faces]
+    n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
+    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
+    a, b = _face_pairs(faces)
+    return centre, under, a, b, np.einsum("nd,nd->n", n[a], n[b])
 
 
 @pytest.mark.parametrize("params", [{"gender": 1.0, "age": 0.5}, WOMAN])
@@ -870,17 +876,7 @@ def test_jacket_over_a_tshirt_does_not_fold_under_the_arm(params):
     count = len(fitted.garment.mesh.vertices)
     v = fitted.mesh.vertices[:count].astype(np.float64)
     faces = fitted.garment.mesh.faces
-    marks = AuthoringBody(human.body).marks
-    centre = v[faces].mean(axis=1)
-    shoulder = marks.shoulder[:, 2].mean()
-    under = ((np.abs(centre[:, 0]) > 0.1) & (np.abs(centre[:, 0]) < 0.26)
-             & (np.abs(centre[:, 1] - marks.shoulder[:, 1].mean()) < 0.06)
-             & (centre[:, 2] > shoulder - 0.25) & (centre[:, 2] < shoulder))  # fmt: skip
-    q = v[faces]
-    n = np.cross(q[:, 2] - q[:, 0], q[:, -1] - q[:, 1])
-    n /= np.maximum(np.linalg.norm(n, axis=1), 1e-12)[:, None]
-    a, b = _face_pairs(faces)
-    turn = np.einsum("nd,nd->n", n[a], n[b])
+    centre, under, a, b, turn = _under_arm_turns(v, faces, AuthoringBody(human.body).marks)
     folded = (under[a] | under[b]) & (turn < -0.5)
     assert not folded.any(), centre[a[folded]].round(3)
     # The untangled cloth stays out of the body.

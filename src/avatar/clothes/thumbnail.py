@@ -6,7 +6,7 @@ as worn by the default body, seen from the front, in its own colours and cut-out
 
 A fabric swatch told a T-shirt from a tank top only by its name; the picture shows the
 cut (sleeves, hood, hem length, a brim), the colour and, for hair and brows, the style.
-Every face is sampled on a grid fine enough for the picture (``_grid``), each sample
+Every face is sampled on a grid fine enough for the picture (``_samples``), each sample
 takes its colour from the item's colour texture at its UV (an alpha-cut item drops the
 samples under its cutoff, so hair shows strands), shaded by its face's normal under a key
 light; samples go into a z-buffer at twice the size and are averaged down. The body is
@@ -27,6 +27,7 @@ import numpy as np
 from avatar.body.model import BodyModel
 from avatar.body.shaped import PART_GROUPS, Body, default_body
 from avatar.clothes.fitting import FittedGarment
+from avatar.geometry.splat import splat
 from avatar.material import Material
 
 _LIGHT = np.array([-0.45, -0.75, 0.5]) / np.linalg.norm([-0.45, -0.75, 0.5])
@@ -93,6 +94,7 @@ def garment_picture(name: str, size: int = SIZE, body: Body | None = None,
     ``folders``) worn by ``body`` (default: the default body, all macros 0.5). Raises as
     ``library.load_garment`` for a bad name."""
     from avatar.clothes import library
+
     body = body or default_body(BodyModel.shared())
     garment = library.load_garment(name, folders, texture_size=256, model=body.model)
     (fitted,) = library.dress(body, [garment])
@@ -252,18 +254,10 @@ def _draw(points: np.ndarray, colours: np.ndarray, alpha: np.ndarray, size: int,
     scale = big / span
     col = np.floor((points[:, 0] - corner[0]) * scale).astype(np.int64)
     row = np.floor(big - (points[:, 2] - corner[1]) * scale).astype(np.int64)
-    inside = (col >= 0) & (col < big) & (row >= 0) & (row < big)
-    pixel = row[inside] * big + col[inside]
-    order = np.lexsort((points[inside, 1], pixel))  # per pixel, nearest the camera first
-    keep = order[np.unique(pixel[order], return_index=True)[1]]
-    rgba = np.zeros((big * big, 4))
-    rgba[pixel[keep], :3] = colours[inside][keep]
-    rgba[pixel[keep], 3] = alpha[inside][keep]
-    rgba[pixel[keep], :3] *= rgba[pixel[keep], 3:]  # premultiplied, for the averaging
-    rgba = rgba.reshape(size, _SUPER, size, _SUPER, 4).mean(axis=(1, 3))
-    alpha = rgba[..., 3:]
-    rgba[..., :3] = _srgb(np.where(alpha > 0, rgba[..., :3] / np.maximum(alpha, 1e-9), 0.0))
-    return np.round(rgba * 255).astype(np.uint8)
+    rgba = np.concatenate([colours, alpha[:, None]], axis=1)
+    out = splat(col, row, points[:, 1], rgba, size, _SUPER)
+    out[..., :3] = _srgb(out[..., :3])
+    return np.round(out * 255).astype(np.uint8)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from avatar.body.shaped import PART_GROUPS, Body
+from avatar.geometry.splat import splat
 from avatar.rig import kinematics, skinning
 from avatar.rig.skeleton import Animation
 
@@ -70,16 +71,6 @@ def _draw(points: np.ndarray, shade: np.ndarray, size: int) -> np.ndarray:
     centre_x = 0.5 * (points[:, 0].min() + points[:, 0].max())
     col = np.floor((points[:, 0] - centre_x) * scale + big / 2).astype(np.int64)
     row = np.floor(big - 1 - (points[:, 2] + 0.05) * scale).astype(np.int64)  # floor at bottom
-    inside = (col >= 0) & (col < big) & (row >= 0) & (row < big)
-    pixel = row[inside] * big + col[inside]
-    depth = points[inside, 1]  # nearer the camera (on -Y): smaller y
-    order = np.lexsort((depth, pixel))  # per pixel, nearest first
-    first = np.unique(pixel[order], return_index=True)[1]
-    keep = order[first]
-    rgba = np.zeros((big * big, 4))
-    rgba[pixel[keep], :3] = shade[inside][keep, None] * _COLOUR
-    rgba[pixel[keep], 3] = 1.0
-    rgba = rgba.reshape(size, _SUPER, size, _SUPER, 4).mean(axis=(1, 3))
-    alpha = rgba[..., 3:]
-    rgba[..., :3] = np.where(alpha > 0, rgba[..., :3] / np.maximum(alpha, 1e-9), 0.0)
-    return np.round(rgba * 255).astype(np.uint8)
+    rgba = np.concatenate([shade[:, None] * _COLOUR, np.ones((len(shade), 1))], axis=1)
+    out = splat(col, row, points[:, 1], rgba, size, _SUPER)  # nearer the camera: smaller y
+    return np.round(out * 255).astype(np.uint8)
