@@ -164,6 +164,7 @@ class AVATAR_PT_dress(_AvatarPanel, bpy.types.Panel):
                                icon="CHECKMARK" if item.entry in worn else "NONE")  # fmt: skip
             op.name = item.entry
             cell.enabled = root is not None
+        thumbnails.draw_queued()  # one process for every picture this draw found missing
         layout.operator("avatar.bind_garment", icon="MOD_CLOTH")
 
 

@@ -1,12 +1,13 @@
 """Dress panel thumbnails (``bpy.utils.previews``): MakeHuman assets' own ``.thumb`` files,
-and for built-in garments a picture of the item as worn (``avatar.clothes.thumbnail``),
-cached as PNG in Avatar's cache folder.
+and for built-in garments and user garments without one a picture of the item as worn
+(``avatar.clothes.thumbnail``), cached as PNG in Avatar's cache folder.
 
 Drawing all built-ins' pictures takes about a minute (each item is built and fitted), too
 long to hold Blender's interface, and garment building must not run in a thread inside
 Blender (a k-d tree thread crashed it). So the first time the grid is shown without them,
 a separate Python process draws the missing ones (``python -m avatar.clothes.thumbnail``)
-while the grid shows each item's fabric swatch; a timer swaps each picture in as it lands.
+while the grid shows each built-in's fabric swatch (a user garment's plain button); a
+timer swaps each picture in as it lands.
 """
 
 from __future__ import annotations
@@ -44,15 +45,17 @@ class Previews:
 
 
 _DRESS = Previews()  # the Dress panel's library icons
-_SWATCHED: set[str] = set()  # built-ins showing a swatch until their picture lands
-_DRAWER: list[subprocess.Popen] = []  # the process drawing the missing pictures
+_WAITING: set[str] = set()  # entries whose picture is being drawn (a swatch or no icon)
+_QUEUE: list[str] = []  # entries to draw, started together by ``draw_queued``
+_DRAWER: list[subprocess.Popen] = []  # the processes drawing the missing pictures
 POLL_S = 1.0
 
 
 def release() -> None:
-    """Close the icons, stop the drawing process and its timer (unregister)."""
+    """Close the icons, stop the drawing processes and their timer (unregister)."""
     _DRESS.release()
-    _SWATCHED.clear()
+    _WAITING.clear()
+    _QUEUE.clear()
     if bpy.app.timers.is_registered(_swap_pictures):
         bpy.app.timers.unregister(_swap_pictures)
     for process in _DRAWER:
@@ -62,46 +65,51 @@ def release() -> None:
 
 
 def icon(entry: str, thumbnail: str) -> int:
-    """The preview icon id of a library entry (0: none, the panel shows a plain button)."""
+    """The preview icon id of a library entry (a built-in's name or a user garment's file;
+    0: none, the panel shows a plain button). An entry with neither its own ``.thumb`` nor
+    a drawn picture is queued for drawing (``draw_queued``): a built-in shows its fabric
+    swatch meanwhile, a user garment a plain button."""
     previews = _DRESS.get()
     if entry in previews:
         return previews[entry].icon_id
-    path = thumbnail if thumbnail and os.path.isfile(thumbnail) else _builtin_picture(entry)
+    if entry in _WAITING:
+        return 0
+    path = thumbnail if thumbnail and os.path.isfile(thumbnail) else _picture(entry)
     if not path:
+        _WAITING.add(entry)
+        _QUEUE.append(entry)
         path = _builtin_swatch(entry)
-        if path:
-            _SWATCHED.add(entry)
-            _draw_pictures()
     if not path:
         return 0
     return previews.load(entry, path, "IMAGE").icon_id
 
 
-def _builtin_picture(name: str) -> str:
-    """The cached picture of a built-in item ("" while it is not drawn, or not a built-in)."""
+def _picture(entry: str) -> str:
+    """The cached picture of a library entry ("" while it is not drawn)."""
     try:
-        from avatar.clothes import builtin, thumbnail
+        from avatar.clothes import thumbnail
 
-        if name not in builtin.BY_NAME:
-            return ""
-        path = thumbnail.picture_path(name)
+        path = thumbnail.picture_path(entry)
         return str(path) if path.is_file() else ""
     except Exception as exc:  # noqa: BLE001 - a missing picture must not break the panel
-        log.warning("Avatar: no picture for %s (%s)", name, exc)
+        log.warning("Avatar: no picture for %s (%s)", entry, exc)
         return ""
 
 
-def _draw_pictures() -> None:
-    """Start, once a session, the process that draws the missing built-in pictures, and the
-    timer that swaps them in. Nothing happens without a Python interpreter to run it."""
-    if _DRAWER:
+def draw_queued() -> None:
+    """Start one process drawing the pictures ``icon`` queued (the grid calls it after its
+    items), and the timer that swaps them in. Nothing happens without a Python
+    interpreter to run it: the swatches and buttons stay."""
+    if not _QUEUE:
         return
+    items = list(dict.fromkeys(_QUEUE))
+    _QUEUE.clear()
     python = sys.executable or ""
     if "python" not in os.path.basename(python).lower():  # Blender itself: no interpreter
         log.info("Avatar: garment pictures need a Python interpreter; showing swatches")
         return
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
-    command = [python, "-m", "avatar.clothes.thumbnail"]  # not the CLI: no extras needed
+    command = [python, "-m", "avatar.clothes.thumbnail", *items]  # not the CLI: no extras
     try:
         _DRAWER.append(subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL,
                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
@@ -113,26 +121,26 @@ def _draw_pictures() -> None:
 
 
 def _swap_pictures() -> float | None:
-    """Timer: reload the icons of items whose picture has landed and redraw the sidebar;
-    stops once every swatch is replaced or the drawing process has ended."""
+    """Timer: reload the icons of entries whose picture has landed and redraw the sidebar;
+    stops once nothing waits or every drawing process has ended (an entry it could not
+    draw keeps its swatch or button)."""
     previews = _DRESS.get()
-    landed = [name for name in _SWATCHED if _builtin_picture(name)]
-    for name in landed:
-        if name in previews:
-            del previews[name]  # the grid's next draw loads the picture (``icon``)
-        _SWATCHED.discard(name)
+    landed = [entry for entry in _WAITING if _picture(entry)]
+    for entry in landed:
+        if entry in previews:
+            del previews[entry]  # the grid's next draw loads the picture (``icon``)
+        _WAITING.discard(entry)
     if landed:
         _redraw_sidebars()
-    process = _DRAWER[0] if _DRAWER else None
-    if process is None or not _SWATCHED:
+    if not _WAITING:
         return None
-    if process.poll() is not None:
-        if process.returncode:
-            log.warning("Avatar: garment pictures stopped (exit %d); `avatar clothes "
+    running = [process for process in _DRAWER if process.poll() is None]
+    for process in _DRAWER:
+        if process not in running and process.returncode:
+            log.warning("Avatar: some garment pictures not drawn (exit %d); `avatar clothes "
                         "thumbnails` shows why", process.returncode)  # fmt: skip
-        if not [name for name in _SWATCHED if _builtin_picture(name)]:
-            return None
-    return POLL_S
+    _DRAWER[:] = running
+    return POLL_S if running else None
 
 
 def _redraw_sidebars() -> None:

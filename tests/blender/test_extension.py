@@ -438,32 +438,73 @@ def test_the_dress_grid_swaps_swatches_for_pictures_drawn_outside_blender(instal
     """A built-in with no cached picture shows its swatch at once; a separate Python process
     draws the picture (``python -m avatar.clothes.thumbnail``) and the grid's timer swaps
     it in; unregistering stops the process."""
-    import importlib
-    import time
-
-    from extension_fixtures import ADDON
-
     from avatar.clothes import thumbnail
 
-    thumbnails = importlib.import_module(f"{ADDON}.thumbnails")
-    thumbnails.release()
+    thumbnails = _thumbnails_module()
     picture = thumbnail.picture_path("tshirt")
     picture.unlink(missing_ok=True)
     try:
         thumbnails.icon("tshirt", "")  # (icon ids are 0 headless: no GPU to draw them)
         assert "tshirt" in thumbnails._DRESS.get()  # the swatch, at once
-        assert "tshirt" in thumbnails._SWATCHED and len(thumbnails._DRAWER) == 1
-        deadline = time.monotonic() + 300
-        while not picture.is_file() and thumbnails._DRAWER[0].poll() is None:
-            assert time.monotonic() < deadline, "no picture drawn in 5 minutes"
-            time.sleep(0.5)
-        assert picture.is_file(), f"drawer exited {thumbnails._DRAWER[0].returncode}"
+        assert "tshirt" in thumbnails._WAITING and not thumbnails._DRAWER
+        thumbnails.draw_queued()  # what the grid does after its items
+        process = _wait_for(thumbnails, picture)
         thumbnails._swap_pictures()  # what the timer does (timers do not run headless)
-        assert "tshirt" not in thumbnails._SWATCHED
+        assert "tshirt" not in thumbnails._WAITING
         assert "tshirt" not in thumbnails._DRESS.get()  # reloaded on the next draw...
         thumbnails.icon("tshirt", "")
-        assert "tshirt" in thumbnails._DRESS.get() and "tshirt" not in thumbnails._SWATCHED
-        process = thumbnails._DRAWER[0]
+        assert "tshirt" in thumbnails._DRESS.get() and "tshirt" not in thumbnails._WAITING
     finally:
         thumbnails.release()
     assert process.wait(timeout=30) is not None and not thumbnails._DRAWER
+
+
+def test_a_user_garment_without_a_thumb_gets_a_drawn_picture(installed, fixtures, tmp_path):
+    """A user's garment with no ``.thumb`` showed a plain button for good; the grid now
+    queues it with the built-ins' missing pictures, one process draws them all, and the
+    picture replaces the button."""
+    import shutil
+
+    from avatar.clothes import thumbnail
+
+    source = fixtures / "makehuman" / "clothes" / "shoes02"
+    shutil.copytree(source, tmp_path / "shoes02", ignore=shutil.ignore_patterns("*.thumb"))
+    entry = str(tmp_path / "shoes02" / "shoes02.mhclo")
+    thumbnails = _thumbnails_module()
+    picture = thumbnail.picture_path(entry)
+    try:
+        assert thumbnails.icon(entry, "") == 0  # a plain button while it is drawn
+        assert entry in thumbnails._WAITING and entry not in thumbnails._DRESS.get()
+        thumbnails.draw_queued()
+        assert len(thumbnails._DRAWER) == 1
+        process = _wait_for(thumbnails, picture)
+        thumbnails._swap_pictures()
+        thumbnails.icon(entry, "")
+        assert entry in thumbnails._DRESS.get() and not thumbnails._WAITING
+    finally:
+        thumbnails.release()
+    assert process.wait(timeout=30) is not None
+    picture.unlink()
+
+
+def _thumbnails_module():
+    import importlib
+
+    from extension_fixtures import ADDON
+
+    thumbnails = importlib.import_module(f"{ADDON}.thumbnails")
+    thumbnails.release()
+    return thumbnails
+
+
+def _wait_for(thumbnails, picture):
+    """The drawing process, once ``picture`` has landed (or it has exited)."""
+    import time
+
+    process = thumbnails._DRAWER[0]
+    deadline = time.monotonic() + 300
+    while not picture.is_file() and process.poll() is None:
+        assert time.monotonic() < deadline, "no picture drawn in 5 minutes"
+        time.sleep(0.5)
+    assert picture.is_file(), f"drawer exited {process.returncode}"
+    return process

@@ -121,3 +121,92 @@ def test_large_faces_are_covered_without_pinholes(human):
         inner = cloth[:-2, 1:-1] & cloth[2:, 1:-1] & cloth[1:-1, :-2] & cloth[1:-1, 2:]
         holes = inner & ~cloth[1:-1, 1:-1]
         assert holes.sum() <= 0.002 * cloth.sum(), (name, int(holes.sum()))
+
+
+@pytest.fixture
+def user_suit(fixtures, tmp_path):
+    """A MakeHuman CC0 garment copied without its ``.thumb`` (a user's own garment)."""
+    import shutil
+
+    source = fixtures / "makehuman" / "clothes" / "female_casualsuit01"
+    folder = tmp_path / "assets" / "suit"
+    shutil.copytree(source, folder, ignore=shutil.ignore_patterns("*.thumb"))
+    return folder / "female_casualsuit01.mhclo"
+
+
+def test_a_user_garment_without_a_thumb_is_drawn_in_its_own_texture(user_suit, human):
+    """A MakeHuman garment with no ``.thumb`` showed a plain button in the Dress grid; it is
+    now drawn as worn, like a built-in, in the colours of its own diffuse texture."""
+    from PIL import Image
+
+    image = thumbnail.garment_picture(str(user_suit), 96, human)
+    cloth = _cloth(image)
+    width, height = _extent(cloth)
+    assert cloth.sum() > 800 and height > 1.8 * width, (cloth.sum(), width, height)  # a suit
+    with Image.open(user_suit.parent / "female_casualsuit01_diffuse.png") as texture:
+        texels = np.asarray(texture.convert("RGB"), dtype=float).reshape(-1, 3)
+    drawn = image[cloth][:, :3].astype(float).mean(axis=0)
+    own = texels.mean(axis=0)
+    assert own[2] > 1.3 * own[0] and drawn[2] > 1.3 * drawn[0], (drawn, own)  # blue shirt, jeans
+
+
+def test_a_user_garments_picture_is_named_for_its_file_and_its_state(user_suit, tmp_path,
+                                                                     monkeypatch):  # fmt: skip
+    """Two folders' garments of one name get two pictures; editing the asset (its mesh,
+    material or textures) draws a new one; a built-in's name is unchanged."""
+    import os
+    import shutil
+
+    monkeypatch.setenv("AVATAR_CACHE", str(tmp_path / "cache"))
+    other = tmp_path / "other" / "suit"
+    shutil.copytree(user_suit.parent, other)
+    first = thumbnail.picture_path(str(user_suit))
+    assert first.name.startswith("user-female_casualsuit01-") and first.parent.name == "thumbnails"
+    assert thumbnail.picture_path(str(other / user_suit.name)) != first
+    texture = user_suit.parent / "female_casualsuit01_diffuse.png"
+    os.utime(texture, ns=(texture.stat().st_atime_ns, texture.stat().st_mtime_ns + 10**9))
+    assert thumbnail.picture_path(str(user_suit)) != first
+    assert thumbnail.picture_path("tshirt").name.startswith("tshirt-128-")
+
+
+def test_the_drawing_process_draws_user_garments_and_skips_a_broken_one(user_suit, tmp_path):
+    """``python -m avatar.clothes.thumbnail ITEM...`` (what the Blender extension starts):
+    a broken garment file costs only its own picture, named on one line of stderr."""
+    import os
+    import subprocess
+    import sys
+
+    broken = tmp_path / "broken" / "broken.mhclo"
+    broken.parent.mkdir()
+    broken.write_text("name broken\nobj_file missing.obj\n")
+    env = dict(os.environ, AVATAR_CACHE=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join(sys.path))  # fmt: skip
+    run = subprocess.run([sys.executable, "-m", "avatar.clothes.thumbnail", str(broken),
+                          str(user_suit)], env=env, capture_output=True, text=True,
+                         timeout=600)  # fmt: skip
+    assert run.returncode == 1, run.stderr
+    errors = run.stderr.strip().splitlines()
+    assert len(errors) == 1 and str(broken) in errors[0] and "Traceback" not in run.stderr
+    pictures = list((tmp_path / "cache" / "thumbnails").glob("user-*.png"))
+    assert [p.name.split("-")[1] for p in pictures] == ["female_casualsuit01"]
+
+
+def test_cli_draws_a_user_garment_found_by_name_in_a_folder(user_suit, tmp_path, capsys):
+    from avatar import cli
+
+    out = tmp_path / "pictures"
+    folder = str(user_suit.parent.parent)
+    assert cli.main(["clothes", "thumbnails", "female_casualsuit01", "--folder", folder,
+                     "--out", str(out), "--size", "32"]) == 0  # fmt: skip
+    assert [p.name for p in out.iterdir()] == ["female_casualsuit01.png"]
+
+
+def test_makehuman_shoes_are_drawn_in_profile_by_their_tags(fixtures, human):
+    """A MakeHuman garment's category is only "clothes" and its shoes come with socks up
+    the calf: its tags tell footwear, drawn in profile like the built-ins."""
+    shoes = fixtures / "makehuman" / "clothes" / "shoes02" / "shoes02.mhclo"
+    mask = _cloth(thumbnail.garment_picture(str(shoes), 96, human))
+    sole = mask[np.flatnonzero(mask.any(axis=1))[-1] - 3]  # a row just above the sole
+    columns = np.flatnonzero(sole)
+    assert np.all(np.diff(columns) == 1), columns  # one shoe, not two with floor between
+    assert len(columns) > 0.6 * _extent(mask)[0], len(columns)  # its length, heel to toe

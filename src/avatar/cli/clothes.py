@@ -84,14 +84,14 @@ def run_thumbnails(args: argparse.Namespace) -> int:
     if not 16 <= args.size <= 1024:
         raise ParameterError(f"--size must be 16-1024 pixels, got {args.size}")
     names = args.names or [e.name for e in library.builtin_entries()]
-    for name in names:
-        library.entry_of(name, args.folder or ())  # unknown: ParameterError, close matches
+    # unknown: ParameterError naming close matches; a user item's picture is of its file
+    sources = [library.find_garment(name, args.folder or ()) for name in names]
     if args.missing and not args.out:
-        for written in thumbnail.draw_missing(names, args.size):
+        for written in thumbnail.draw_missing(sources, args.size):
             print(f"wrote {written}", flush=True)
         return 0
-    for name in names:
-        path = Path(args.out) / f"{name}.png" if args.out else None
-        written = thumbnail.write_picture(name, args.size, path, folders=args.folder or ())
+    for name, source in zip(names, sources, strict=True):
+        path = Path(args.out) / f"{Path(name).stem}.png" if args.out else None
+        written = thumbnail.write_picture(source, args.size, path)
         print(f"wrote {written}", flush=True)
     return 0

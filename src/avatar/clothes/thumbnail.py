@@ -19,6 +19,7 @@ three-quarters from the front, where a ponytail or a bun shows.
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
 from pathlib import Path
 
@@ -35,6 +36,7 @@ _AMBIENT = 0.4
 _BODY_GREY = 0.30  # the mannequin's linear grey, drawn at _BODY_ALPHA (a ghost for scale)
 _BODY_ALPHA = 0.5
 _FOOT_HIGH = 0.3  # m above the soles: an uncategorised item no higher is footwear
+_FOOTWEAR_TAGS = {"shoes", "shoe", "boots", "sneakers", "sandals", "footwear"}
 _SUPER = 2  # supersampling factor
 _MARGIN = 1.12  # the frame's span over the item's larger extent
 _MIN_SPAN = 0.11  # m: brows and lashes are framed on the eyes, not on a few millimetres
@@ -43,13 +45,41 @@ _MIN_SPAN = 0.11  # m: brows and lashes are framed on the eyes, not on a few mil
 SIZE = 128  # px: the Dress panel's grid shows them at about 96 px
 
 
-def picture_path(name: str, size: int = SIZE) -> Path:
-    """Where the cached picture of library item ``name`` lives: under Avatar's cache folder,
-    named for this code's version (``disk_cache.code_fingerprint``), so a changed garment
-    gets a new picture."""
+def picture_path(item: str, size: int = SIZE) -> Path:
+    """Where the cached picture of library ``item`` (a built-in's name or a garment file's
+    path) lives: under Avatar's cache folder, named for this code's version
+    (``disk_cache.code_fingerprint``), so a changed garment gets a new picture; a user
+    garment's name also carries its folder's state, so an edited asset does too."""
     from avatar.body.assets import cache_root
 
-    return cache_root() / "thumbnails" / f"{name}-{size}-{_code()}.png"
+    stem, version = _key(item), _code()
+    if stem != item:
+        version += _folder_state(Path(item))
+    return cache_root() / "thumbnails" / f"{stem}-{size}-{version}.png"
+
+
+def _key(item: str) -> str:
+    """A picture's file-name stem: a built-in's name, or a garment file's stem and a digest
+    of its path (two folders' ``shirt.mhclo`` are two pictures)."""
+    if os.sep not in item and "/" not in item and not item.lower().endswith(".mhclo"):
+        return item
+    path = Path(item).resolve()
+    digest = hashlib.sha256(str(path).encode()).hexdigest()[:8]
+    return f"user-{path.stem}-{digest}"
+
+
+def _folder_state(garment: Path) -> str:
+    """A digest of the names, sizes and times of the files beside a garment file (its mesh,
+    textures and material): what, changed, changes its picture."""
+    h = hashlib.sha256()
+    try:
+        for path in sorted(garment.resolve().parent.iterdir()):
+            if path.is_file():
+                stat = path.stat()
+                h.update(f"{path.name}|{stat.st_size}|{stat.st_mtime_ns}".encode())
+    except OSError:  # unreadable: the picture is drawn again next time
+        h.update(b"?")
+    return h.hexdigest()[:6]
 
 
 @functools.cache
@@ -71,17 +101,18 @@ def write_picture(name: str, size: int = SIZE, path: str | os.PathLike[str] | No
     image = garment_picture(name, size, body, folders)
     out.parent.mkdir(parents=True, exist_ok=True)
     png.write(out, image)
-    if path is None:  # older code's pictures of this item are not read again
-        for old in out.parent.glob(f"{name}-{size}-*.png"):
+    if path is None:  # older code's (or files') pictures of this item are not read again
+        for old in out.parent.glob(f"{_key(name)}-{size}-*.png"):
             if old != out:
                 old.unlink(missing_ok=True)
     return out
 
 
 def draw_missing(names: list[str] | None = None, size: int = SIZE) -> list[Path]:
-    """Draw the cached pictures of ``names`` (default: every built-in) that are missing;
-    returns the paths written. ``python -m avatar.clothes.thumbnail`` runs it: the Blender
-    extension starts it as a separate process, which needs none of the CLI's extras."""
+    """Draw the cached pictures of ``names`` (built-in names or garment file paths; default:
+    every built-in) that are missing; returns the paths written. ``python -m
+    avatar.clothes.thumbnail [ITEM...]`` runs it: the Blender extension starts it as a
+    separate process, which needs none of the CLI's extras."""
     from avatar.clothes import library
 
     names = names if names is not None else [e.name for e in library.builtin_entries()]
@@ -132,9 +163,12 @@ def picture(fitted: FittedGarment, body, size: int = 128) -> np.ndarray:
 def _yaw(fitted: FittedGarment, top: float) -> int:
     """Degrees the camera turns from the front towards the wearer's left: footwear in
     profile (where a shoe reads as a shoe), hair three-quarters (a ponytail or bun hides
-    behind the head from the front), the rest from the front."""
+    behind the head from the front), the rest from the front. A MakeHuman garment is
+    only "clothes": its tags or its height tell footwear."""
     category = fitted.garment.category
-    if category == "footwear" or (not category and top < _FOOT_HIGH):
+    if category == "footwear" or _FOOTWEAR_TAGS & set(fitted.garment.tags):
+        return 90
+    if category in ("", "clothes") and top < _FOOT_HIGH:
         return 90
     return 55 if category == "hair" else 0
 
@@ -260,8 +294,26 @@ def _draw(points: np.ndarray, colours: np.ndarray, alpha: np.ndarray, size: int,
     return np.round(out * 255).astype(np.uint8)
 
 
+def _main(items: list[str]) -> int:
+    """Draw the missing pictures of ``items`` (default: every built-in), one at a time, so
+    that a broken user garment costs only its own picture (a line on stderr, exit 1)."""
+    import sys
+
+    from avatar.clothes import library
+    from avatar.errors import AvatarError
+
+    failed = 0
+    for item in items or [e.name for e in library.builtin_entries()]:
+        try:
+            for path in draw_missing([item]):
+                sys.stdout.write(f"wrote {path}\n")
+        except (AvatarError, OSError) as exc:
+            sys.stderr.write(f"{item}: {exc}\n")
+            failed = 1
+    return failed
+
+
 if __name__ == "__main__":
     import sys
 
-    for path in draw_missing():
-        sys.stdout.write(f"wrote {path}\n")
+    sys.exit(_main(sys.argv[1:]))
