@@ -143,8 +143,10 @@ class AvatarMotionSettings(bpy.types.PropertyGroup):
             name="Stop", min=0, default=0,
             description="Source frame to stop before (0 = to the end of the clip)",
         ),
-        "fps": FloatProperty(name="FPS", min=0.0, default=0.0,
-                             description="Resample to this rate (0 = the clip's own)"),
+        "resample": BoolProperty(name="Resample", default=False,
+                                 description="Resample the clip to FPS (off: its own rate)"),
+        "fps": FloatProperty(name="FPS", min=1.0, max=1000.0, default=30.0,
+                             description="The rate to resample to (with Resample on)"),
         "in_place": BoolProperty(name="In place", default=False,
                                  description="Remove the horizontal root motion"),
         "bones": CollectionProperty(type=AvatarBoneRow),
@@ -238,7 +240,7 @@ def motion_spec(settings, path: str) -> dict:
     frames = None
     if settings.frame_start or settings.frame_end:
         frames = [settings.frame_start, settings.frame_end or None]  # a Python slice, A:B
-    spec = {"path": path, "frames": frames, "fps": settings.fps or None,
+    spec = {"path": path, "frames": frames, "fps": settings.fps if settings.resample else None,
             "in_place": settings.in_place}  # fmt: skip
     if settings.custom_map:
         spec["bone_map"] = custom_table(settings)
@@ -655,8 +657,11 @@ def _draw_clip(layout, settings):
     row.prop(settings, "frame_start")
     row.prop(settings, "frame_end")
     row = layout.row(align=True)
-    row.prop(settings, "fps")
-    row.prop(settings, "in_place")
+    row.prop(settings, "resample", toggle=True)
+    fps = row.row(align=True)
+    fps.active = settings.resample  # "FPS 0.00" read as a broken clip; off, it is the clip's
+    fps.prop(settings, "fps")
+    layout.prop(settings, "in_place")
     row = layout.row()
     row.scale_y = 1.3
     row.operator("avatar.apply_motion", icon="PLAY")

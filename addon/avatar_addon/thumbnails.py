@@ -111,8 +111,9 @@ def draw_queued() -> None:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     command = [python, "-m", "avatar.clothes.thumbnail", *items]  # not the CLI: no extras
     try:
-        _DRAWER.append(subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL,
-                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with open(_drawing_log(), "a", encoding="utf-8") as log_file:  # why one failed
+            _DRAWER.append(subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL,
+                                            stdout=subprocess.DEVNULL, stderr=log_file))
     except OSError as exc:
         log.warning("Avatar: garment pictures not drawn (%s); showing swatches", exc)
         return
@@ -137,10 +138,19 @@ def _swap_pictures() -> float | None:
     running = [process for process in _DRAWER if process.poll() is None]
     for process in _DRAWER:
         if process not in running and process.returncode:
-            log.warning("Avatar: some garment pictures not drawn (exit %d); `avatar clothes "
-                        "thumbnails` shows why", process.returncode)  # fmt: skip
+            log.warning("Avatar: some garment pictures not drawn (exit %d); %s says why",
+                        process.returncode, _drawing_log())  # fmt: skip
     _DRAWER[:] = running
     return POLL_S if running else None
+
+
+def _drawing_log() -> str:
+    """The file the drawing processes write their errors to (one line per item)."""
+    from avatar.body import assets
+
+    folder = assets.cache_root() / "thumbnails"
+    folder.mkdir(parents=True, exist_ok=True)
+    return str(folder / "drawing.log")
 
 
 def _redraw_sidebars() -> None:

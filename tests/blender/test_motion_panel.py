@@ -133,6 +133,21 @@ def test_panel_settings_and_operators_register(installed):
 # ------------------------------------------------------------------------ clips
 
 
+def test_the_clip_plays_at_its_own_rate_unless_resample_is_on(installed):
+    """The rate field read "FPS 0.00" (0 meaning the clip's own rate), taken for a broken
+    clip in the real window: a Resample toggle now says it, and FPS is a real rate."""
+    settings = _settings()
+    spec = _module("panel_motion").motion_spec
+    settings.resample = False
+    assert settings.fps == 30.0 and spec(settings, "walk.bvh")["fps"] is None
+    settings.resample, settings.fps = True, 24.0
+    try:
+        assert spec(settings, "walk.bvh")["fps"] == 24.0
+    finally:
+        settings.resample, settings.fps = False, 30.0
+
+
+
 @needs_clips
 def test_a_folder_lists_its_clips_and_reports_a_bad_one(human, tmp_path):
     import bpy

@@ -96,6 +96,15 @@ XVFB_PID=$!
 sleep 1
 export DISPLAY="$DISPLAY_NUM"
 
+# A user's garment with no .thumb (a MakeHuman CC0 fixture, copied without it): the grid
+# must draw its picture as it does the built-ins'.
+USER_SHOES="$ROOT/../shared/fixtures/makehuman/clothes/shoes02"
+if [[ -d "$USER_SHOES" ]]; then
+  mkdir -p "$WORK/clothes" && cp -r "$USER_SHOES" "$WORK/clothes/"
+  rm "$WORK/clothes/shoes02/shoes02.thumb"
+fi
+
+AVATAR_CLOTHES_PATH="$WORK/clothes" \
 AVATAR_UI_BVH="${AVATAR_UI_BVH:-$ROOT/../shared/fixtures/bvh/cmu_motionbuilder/02_01_walk.bvh}" \
 AVATAR_UI_OUT="$OUT" BLENDER_USER_SCRIPTS="$WORK/scripts" BLENDER_USER_CONFIG="$WORK/config" \
 AVATAR_PYTHONPATH="$LIBPATH" \
@@ -155,6 +164,19 @@ done
 click $((LEFT + LIBRARY_DX)) $((TOP + LIBRARY_DY))  # Dress > Load Library
 sleep 3
 shot library
+if [[ -d "$WORK/clothes/shoes02" ]]; then  # the user's garment: its picture drawn and shown
+  touch "$OUT/request-search-shoes02"
+  CACHE="$(PYTHONPATH="$ROOT/src" "$PY" -c "from avatar.body.assets import cache_root; \
+print(cache_root())")"
+  for _ in $(seq 40); do
+    sleep 3
+    compgen -G "$CACHE/thumbnails/user-shoes02-*.png" > /dev/null && break
+  done
+  sleep 3   # the grid's timer swaps the picture in
+  shot library-user
+  touch "$OUT/request-search-"
+  sleep 1
+fi
 wear() {  # wear DX DY NAME: click a grid cell, poll until the garment is on (a click
   # on a busy window can be lost: up to three clicks, each given 16 s to show)
   for _ in 1 2 3; do

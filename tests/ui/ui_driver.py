@@ -10,6 +10,7 @@ in $AVATAR_UI_OUT, polling on a timer so Blender's UI stays live between them:
 - ``request-undo`` -> Edit > Undo in the window (``bpy.ops.ed.undo``).
 - ``request-bvh`` -> the Motion panel's BVH set to ``$AVATAR_UI_BVH`` (30 frames), as
   typing a path would.
+- ``request-search-TEXT`` -> the Dress grid's search set to TEXT ("" clears it).
 - ``request-quit`` -> quit Blender.
 """
 
@@ -65,6 +66,9 @@ def serve():
             window, area = _view3d()
             with bpy.context.temp_override(window=window, area=area):
                 bpy.ops.ed.undo()
+        if name.startswith("request-search-"):
+            bpy.context.scene.avatar.garment_search = name[len("request-search-") :]
+            _view3d()[1].tag_redraw()  # a property set from a timer redraws nothing
         if name == "request-bvh":
             bpy.context.scene.avatar_motion.bvh_path = os.environ.get("AVATAR_UI_BVH", "")
             bpy.context.scene.avatar_motion.frame_end = 30

@@ -308,7 +308,8 @@ def _main(items: list[str]) -> int:
             for path in draw_missing([item]):
                 sys.stdout.write(f"wrote {path}\n")
         except (AvatarError, OSError) as exc:
-            sys.stderr.write(f"{item}: {exc}\n")
+            message = str(exc) if item in str(exc) else f"{item}: {exc}"  # names the file
+            sys.stderr.write(message.splitlines()[0] + "\n")
             failed = 1
     return failed
 
