@@ -14,7 +14,14 @@ from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, single_references
 from avatar.clothes.hair import around, cards_on, head_frame, per_corner
 from avatar.geometry.shell import boundary_edges
-from avatar.looks.facial_hair import CHEEK_DEG, CHEEK_M, EDGE_M, WOBBLE_M  # noqa: F401
+from avatar.looks.facial_hair import (  # noqa: F401
+    CHEEK_DEG,
+    CHEEK_M,
+    EDGE_M,
+    WOBBLE_M,
+    beard_edge,
+    cheek_wobble,
+)
 from avatar.mesh import Mesh, vertex_normals
 
 
@@ -217,8 +224,9 @@ def mouth_frame(body: AuthoringBody) -> tuple[np.ndarray, np.ndarray, float, flo
 
 def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> np.ndarray:
     """(N,) how densely facial hair grows at ``points`` (N, 3) on the skin, 0..1: 1 well
-    inside, falling off smoothly over ``EDGE_M`` (1 cm) at every edge, along a line that
-    wanders by a few millimetres (a beard's edge is neither straight nor sharp).
+    inside, falling off smoothly at every edge (over ``EDGE_M``, 1 cm; up the cheeks over
+    ``CHEEK_FADE_M``, ``looks.facial_hair.cheek_fade``), along a line that wanders by a
+    few millimetres (a beard's edge is neither straight nor sharp).
 
     part "beard": chin, jaw, cheeks below the cheek line (``CHEEK_*``), sideburns,
     moustache and the throat under the chin; "moustache": the upper lip from under the
@@ -239,17 +247,8 @@ def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> n
             * _soft((rel_z - bottom) / 0.002)
             * _soft((1 - across) / 0.12)
         )
-    angle = np.radians(turn)
-    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
-    top = np.interp(turn, CHEEK_DEG, CHEEK_M) + wobble
-    under = points[:, 2] - (chin_z - 0.02) + 0.5 * wobble  # the throat, down 2 cm
-    back = np.radians(88 - turn) * 0.08  # m round the head in front of the ear
-    return (
-        _soft((top - rel_z) / EDGE_M)
-        * _soft(under / EDGE_M)
-        * _soft(back / (0.6 * EDGE_M))
-        * (points[:, 2] < eye_z)
-    )
+    under = points[:, 2] - (chin_z - 0.02) + 0.5 * cheek_wobble(turn)  # the throat, down 2 cm
+    return beard_edge(turn, rel_z) * _soft(under / EDGE_M) * (points[:, 2] < eye_z)
 
 
 MOUSTACHE_HALF_M = 0.028  # from the middle of the lip to the corner of the mouth

@@ -26,6 +26,14 @@ CHEEK_DEG = (0, 10, 18, 24, 32, 45, 58, 70, 80, 88)
 CHEEK_M = (0.017, 0.014, 0.006, 0.004, 0.012, 0.024, 0.036, 0.05, 0.062, 0.066)
 EDGE_M = 0.01  # the beard thins out over this band at its edges (density 1 -> 0)
 WOBBLE_M = 0.004  # how far the edge wanders off the line (irregular, as hair grows)
+# ... but on the cheeks (between the CHEEK_FADE_DEG pairs, blending from EDGE_M at the
+# corner of the mouth and the sideburns) over CHEEK_FADE_M up the face, some 1.6 cm
+# across the slanted line on the skin: over EDGE_M its 10-90 % fall-off measured 4.4 mm
+# on the skin, and the cheek line read as drawn with a pen. The fade grows down into
+# the beard; its bare end rises only CHEEK_RAISE_M (no hair on the cheekbones).
+CHEEK_FADE_M = 0.036
+CHEEK_FADE_DEG = (18, 32, 72, 86)
+CHEEK_RAISE_M = 0.002
 ARC_RADIUS_M = 0.075  # stubble u: arc length round the face at about this radius
 
 # The stubble atlas: u over [-SPAN_U, SPAN_U] m of arc, v over [V_LOW, V_HIGH] m from the
@@ -53,16 +61,32 @@ def _soft(x: np.ndarray) -> np.ndarray:
     return t * t * (3 - 2 * t)
 
 
-def beard_edge(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
-    """(N,) density of a full beard from its upper (cheek) line and its back edge in front
-    of the ears, 0..1, falling off over ``EDGE_M``: turn_deg, degrees round the head from
-    the front (absolute); rel_z, m above the mouth. (The throat's edge depends on the chin:
-    ``clothes.face.facial_hair_density``.)"""
+def cheek_wobble(turn_deg: np.ndarray) -> np.ndarray:
+    """(N,) m the beard's edges wander off their lines at ``turn_deg`` round the head."""
     angle = np.radians(turn_deg)
-    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
-    top = np.interp(turn_deg, CHEEK_DEG, CHEEK_M) + wobble
+    return WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
+
+
+def cheek_fade(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
+    """(N,) density of a full beard under its upper (cheek) line, 0..1: turn_deg, degrees
+    round the head from the front (absolute); rel_z, m above the mouth. It thins out over
+    ``EDGE_M`` up the face by the mouth and the sideburns, over ``CHEEK_FADE_M`` on the
+    cheeks (``CHEEK_FADE_DEG``), bare from ``EDGE_M / 2`` (plus ``CHEEK_RAISE_M`` on the
+    cheeks) above the wandering line."""
+    top = np.interp(turn_deg, CHEEK_DEG, CHEEK_M) + cheek_wobble(turn_deg)
+    wide = np.interp(turn_deg, CHEEK_FADE_DEG, (0.0, 1.0, 1.0, 0.0))
+    width = EDGE_M + wide * (CHEEK_FADE_M - EDGE_M)
+    bare = top + EDGE_M / 2 + wide * CHEEK_RAISE_M
+    return _soft((bare - width / 2 - rel_z) / width)
+
+
+def beard_edge(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
+    """(N,) density of a full beard from its upper (cheek) line (``cheek_fade``) and its
+    back edge in front of the ears, 0..1: turn_deg, degrees round the head from the front
+    (absolute); rel_z, m above the mouth. (The throat's edge depends on the chin:
+    ``clothes.face.facial_hair_density``.)"""
     back = np.radians(88 - turn_deg) * 0.08
-    return _soft((top - rel_z) / EDGE_M) * _soft(back / (0.6 * EDGE_M))
+    return cheek_fade(turn_deg, rel_z) * _soft(back / (0.6 * EDGE_M))
 
 
 def grey_share(age: float) -> float:
