@@ -583,3 +583,43 @@ def test_grey_beard_is_a_little_darker_than_grey_scalp_hair():
         return np.median(lum[lum > 0.2])
 
     assert light(material) < 0.8 * light(scalp_like), light(material) / light(scalp_like)
+
+
+def test_beard_undercoat_has_no_corduroy():
+    """Down the fully covered undercoat rows (stretched down the whole face) no shade runs
+    a whole texture column: the column means' spectrum at 0.6-5 mm on the face (8-64
+    cycles across the 4 cm texture width) is within a few times its fine-noise floor
+    (128-512 cycles). The scalp layout's locks, one shade a column, put 35 times the
+    floor there at 512 px: fine parallel stripes, corduroy."""
+    size = 512
+    tex = load_garment("beard-short", texture_size=size).material.base_color_texture
+    v = 1 - (np.arange(size // 2) + 0.5) / size
+    full = tex[: size // 2][v > facial_hair.UNDERCOAT_V[1]]  # the fully covered rows
+    full = _linear(full[..., :3]) @ [0.2126, 0.7152, 0.0722]
+    profile = full.mean(axis=0)
+    power = np.abs(np.fft.rfft(profile - profile.mean())) ** 2
+    n = len(power)
+    ratio = power[n // 64 : n // 8].mean() / power[n // 4 :].mean()
+    assert ratio < 6, ratio
+
+
+def test_beard_undercoat_hairs_are_not_parallel(frame):
+    """The undercoat's hairs (along its texture's v, across its u) lean this way and that
+    over the face, a quarter of it by more than 6 degrees from straight down (u the arc
+    round the face alone: under a degree, every hair parallel, corduroy)."""
+    body, (centre, *_) = frame
+    mesh = face.beard_undercoat(body).mesh
+    tri = mesh.vertices[mesh.faces[:, :3]].astype(np.float64)
+    u = mesh.uvs[mesh.face_uvs[:, :3], 0].astype(np.float64)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    normal = np.cross(e1, e2)
+    # u's gradient in each triangle's plane; the hairs run across it.
+    du = np.stack([u[:, 1] - u[:, 0], u[:, 2] - u[:, 0], np.zeros(len(u))], 1)
+    grad = np.linalg.solve(np.stack([e1, e2, normal], 1), du[..., None])[..., 0]
+    hair = np.cross(normal, grad)
+    hair /= np.linalg.norm(hair, axis=1, keepdims=True)
+    rel = tri.mean(axis=1) - centre
+    round_ = np.stack([-rel[:, 1], rel[:, 0], np.zeros(len(rel))], 1)
+    round_ /= np.linalg.norm(round_, axis=1, keepdims=True)
+    lean = np.degrees(np.arcsin(np.clip(np.abs(np.einsum("fd,fd->f", hair, round_)), 0, 1)))
+    assert np.percentile(lean, 75) > 6, np.percentile(lean, 75)

@@ -340,7 +340,7 @@ def beard_undercoat(body: AuthoringBody) -> Piece:
     centre, *_ = mouth_frame(body)
     p = mesh.vertices.astype(np.float64)
     angle = np.arctan2(p[:, 0], -(p[:, 1] - centre[1]))
-    u = angle * fh.ARC_RADIUS_M / UNDERCOAT_TILE_M
+    u = (angle * fh.ARC_RADIUS_M + undercoat_wave(angle, p[:, 2])) / UNDERCOAT_TILE_M
     # Where the beard is full, v also climbs up the face (within the fully covered rows):
     # at one v the texture's tangent along v (the hairs' direction for the anisotropic
     # highlight) was undefined, and the chin shone as one smooth shell.
@@ -349,6 +349,18 @@ def beard_undercoat(body: AuthoringBody) -> Piece:
     v = fh.undercoat_v(density) + fh.UNDERCOAT_CLIMB * np.clip(density, 0, 1) * up
     uv = np.stack([u, v], -1)[mesh.faces].reshape(-1, 2)
     return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
+
+
+UNDERCOAT_WAVE_M = 0.0012  # how far the undercoat's hairs wander sideways (m)
+
+
+def undercoat_wave(angle: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(N,) m the undercoat's u moves round the face at ``angle`` (radians round the
+    head) and height ``z`` (m): two waves up the face whose phase turns round it, so its
+    hairs lean some 10-20 degrees this way and that, patch by patch (u the arc alone
+    combed every hair straight down the face, parallel, as corduroy's wales run)."""
+    return UNDERCOAT_WAVE_M * (0.6 * np.sin(2 * np.pi * z / 0.021 + 3.1 * angle)
+                               + 0.4 * np.sin(2 * np.pi * z / 0.013 - 5.3 * angle + 1.1))
 
 
 def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:

@@ -133,8 +133,11 @@ def beard_material(spec, size: int = 1024) -> Material:
     colour[: size - half, :, 3] = undercoat_alpha(size - half, size, hair, rng)
     # The undercoat is the hair deep in the beard, in the shade of the clumps over it:
     # as light as the cards, the gaps between clumps did not show and the beard read as
-    # one even mat.
-    under = colour[: size - half, :, :3].astype(np.float32)
+    # one even mat. Its hairs in their own shades (``undercoat_shade``): the hair
+    # layout's dense rows keep one lock's shade down a whole column, which the undercoat
+    # stretches down the whole face: fine parallel stripes, corduroy.
+    rgb = fabrics.rgb(spec.colour)[None, None, :] * undercoat_shade(size - half, size, rng)
+    under = _lifted(fabrics.srgb(rgb), fabrics.rgb(spec.colour)).astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
     # No normal map, and the undercoat's roughness even: the hair fabric's grooves run
     # the texture's whole height, and on the undercoat, mapped up the face with v
@@ -231,6 +234,45 @@ def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
     low, high = UNDERCOAT_V
     share = np.clip((v - low) / (high - low), 0, 1)[:, None]
     return np.where(rank < share * 1.02, 255, 0).astype(np.uint8)
+
+
+# The undercoat's shading (``undercoat_shade``): hairs of UNDERCOAT_HAIR_ROWS (of the
+# texture's height; ~1 cm up the face where the beard is full) times 0.5..1.5, each of its
+# own shade (UNDERCOAT_HAIR_SPREAD), in locks UNDERCOAT_LOCKS across the texture's width
+# and one hair's length tall, staggered lock to lock, shaded UNDERCOAT_LOCK_SPREAD.
+UNDERCOAT_HAIR_ROWS = 1 / 96
+UNDERCOAT_HAIR_SPREAD = 0.25
+UNDERCOAT_LOCKS = 32
+UNDERCOAT_LOCK_SPREAD = 0.2
+
+
+def undercoat_shade(rows: int, size: int, rng) -> np.ndarray:
+    """(rows, size, 1) float32 brightness of a beard's undercoat rows (row 0: v = 1),
+    about 0.72 (the hair layout's dense rows): short hairs of random lengths down each
+    column, each of its own shade, in locks that change shade along the hair's length as
+    well as across it. (Locks one shade down the whole column, as the scalp's dense rows
+    have them, ran as parallel stripes down the beard.)"""
+    seg = max(size * UNDERCOAT_HAIR_ROWS, 1.0)
+    # Hair ends down each column at random spacing: 0.5..1.5 of a hair's length.
+    count = int(rows / (0.5 * seg)) + 2
+    ends = np.cumsum(rng.uniform(0.5, 1.5, (count, size)) * seg, axis=0)
+    ends -= rng.uniform(0, seg, size)[None, :]
+    hair = np.empty((rows, size), np.int64)
+    for c in range(size):
+        hair[:, c] = np.searchsorted(ends[:, c], np.arange(rows), side="right")
+    hair = hair * size + np.arange(size)[None, :]
+    own = rng.uniform(1 - UNDERCOAT_HAIR_SPREAD, 1 + UNDERCOAT_HAIR_SPREAD, hair.max() + 1)
+    # Locks: a coarse random grid, smooth in both directions, each lock column's knots
+    # at their own rows (no lock boundaries lining up across the beard).
+    knots = rng.uniform(1 - UNDERCOAT_LOCK_SPREAD, 1 + UNDERCOAT_LOCK_SPREAD,
+                        (int(rows / seg) + 3, UNDERCOAT_LOCKS))  # fmt: skip
+    phase = rng.uniform(0, 1, UNDERCOAT_LOCKS)
+    at = np.arange(rows)[:, None] / seg + phase[None, :]
+    along = np.stack([np.interp(at[:, j], np.arange(len(knots)), knots[:, j])
+                      for j in range(UNDERCOAT_LOCKS)], 1)  # fmt: skip
+    lock_u = np.arange(UNDERCOAT_LOCKS) * size / UNDERCOAT_LOCKS
+    locks = np.stack([np.interp(np.arange(size), lock_u, row, period=size) for row in along])
+    return (0.72 * locks * own[hair])[..., None].astype(np.float32)
 
 
 def stubble_alpha(size: int, seed: int = 0) -> np.ndarray:
