@@ -367,8 +367,9 @@ def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -
     """A short beard's strand cards rooted where ``facial_hair_density(body, "beard",
     ...)`` lets them grow, combed down the face, about a centimetre long, lying close to
     the skin, thinning out (sparser, shorter, flatter) over the last centimetre to its
-    edges. The hair above the mouth (the moustache) and the rest are bound apart: one
-    rides the upper lip, the other the jaw, so opening the mouth parts them.
+    edges (up the cheeks over some two: ``looks.facial_hair.cheek_fade``). The hair
+    above the mouth (the moustache) and the rest are bound apart: one rides the upper
+    lip, the other the jaw, so opening the mouth parts them.
 
     One segment a card (4 vertices: a centimetre-long card bends over the jaw by a tenth
     of a millimetre between its ends)."""
