@@ -11,6 +11,7 @@ from avatar.clothes import face, library
 from avatar.clothes.library import authoring_body, load_garment
 from avatar.geometry import collision
 from avatar.human import Human
+from avatar.looks import facial_hair
 
 ITEMS = ("beard-short", "moustache", "stubble")
 
@@ -138,23 +139,39 @@ def test_beard_edge_follows_the_cheek_line_not_a_level_cut(frame):
     assert 0.0015 < wander.std() < 0.006
 
 
-def test_beard_thins_out_over_a_centimetre_at_its_edges(frame):
-    """Hair density falls from full to none over about a centimetre across the cheek line
-    (not a cut), and the cards there are fewer per area and shorter."""
+def _cheek_fall_off(body, centre, mouth, eye_z, lo=35, hi=70) -> float:
+    """The beard's 10-90 % fall-off across its cheek line, m on the skin: the median
+    distance from points of density 0.9 to the nearest of density 0.1, over skin points
+    ``lo``..``hi`` degrees round the face, between the mouth and the eyes."""
+    from scipy.spatial import cKDTree
+
+    from avatar.clothes.hair import _scatter
+
+    c = body.vertices[body.skin_faces].mean(axis=1).astype(np.float64)
+    turn = face.around(c, centre)
+    cheek = (turn > lo - 5) & (turn < hi + 5) & (c[:, 1] < centre[1] - 0.01)
+    cheek &= (c[:, 2] > mouth[2] - 0.01) & (c[:, 2] < eye_z + 0.01)
+    p = _scatter(body, cheek, 200_000, np.random.default_rng(0))
+    p = p[(face.around(p, centre) > lo) & (face.around(p, centre) < hi)]
+    d = face.facial_hair_density(body, "beard", p)
+    full, bare = p[np.abs(d - 0.9) < 0.02], p[np.abs(d - 0.1) < 0.02]
+    return float(np.median(cKDTree(bare).query(full)[0]))
+
+
+def test_beard_thins_out_over_two_centimetres_on_the_cheeks(frame):
+    """Hair density falls from full to none across the cheek line over some 1.5-2 cm of
+    skin (10 to 90 %: it was 4.4 mm, a line drawn with a pen), without hair climbing
+    onto the cheekbones (bare from 8 mm above the drawn line), and the cards there are
+    fewer per area and shorter."""
     body, (centre, mouth, eye_z, _) = frame
+    width = _cheek_fall_off(body, centre, mouth, eye_z)
+    assert 0.014 < width < 0.022, width
     c = body.vertices[body.skin_faces].mean(axis=1).astype(np.float64)
     density = face.facial_hair_density(body, "beard", c)
     turn = face.around(c, centre)
-    cheek = (turn > 35) & (turn < 65) & (c[:, 1] < centre[1] - 0.01)
-    cheek &= (c[:, 2] > mouth[2] - 0.01) & (c[:, 2] < eye_z + 0.02)  # the face, not the body
-    widths = []
-    for lo in range(35, 65, 5):
-        sel = cheek & (turn >= lo) & (turn < lo + 5)
-        z, d = c[sel, 2], density[sel]
-        upper = z[d > 0.9].max()  # the highest full-density skin ...
-        lower = z[(d < 0.1) & (z > upper)].min()  # ... and the lowest bare skin above it
-        widths.append(lower - upper)
-    assert 0.004 < np.median(widths) < 0.016, widths
+    line = np.interp(turn, face.CHEEK_DEG, face.CHEEK_M) + facial_hair.cheek_wobble(turn)
+    above = (c[:, 2] - mouth[2] > line + 0.008) & (c[:, 1] < centre[1] - 0.01)
+    assert above.sum() > 200 and density[above].max() < 0.02
     roots, length = _roots(face.beard_cards(body))
     grow = face.facial_hair_density(body, "beard", roots)
     quads = body.vertices[body.skin_faces].astype(np.float64)
@@ -566,3 +583,43 @@ def test_grey_beard_is_a_little_darker_than_grey_scalp_hair():
         return np.median(lum[lum > 0.2])
 
     assert light(material) < 0.8 * light(scalp_like), light(material) / light(scalp_like)
+
+
+def test_beard_undercoat_has_no_corduroy():
+    """Down the fully covered undercoat rows (stretched down the whole face) no shade runs
+    a whole texture column: the column means' spectrum at 0.6-5 mm on the face (8-64
+    cycles across the 4 cm texture width) is within a few times its fine-noise floor
+    (128-512 cycles). The scalp layout's locks, one shade a column, put 35 times the
+    floor there at 512 px: fine parallel stripes, corduroy."""
+    size = 512
+    tex = load_garment("beard-short", texture_size=size).material.base_color_texture
+    v = 1 - (np.arange(size // 2) + 0.5) / size
+    full = tex[: size // 2][v > facial_hair.UNDERCOAT_V[1]]  # the fully covered rows
+    full = _linear(full[..., :3]) @ [0.2126, 0.7152, 0.0722]
+    profile = full.mean(axis=0)
+    power = np.abs(np.fft.rfft(profile - profile.mean())) ** 2
+    n = len(power)
+    ratio = power[n // 64 : n // 8].mean() / power[n // 4 :].mean()
+    assert ratio < 6, ratio
+
+
+def test_beard_undercoat_hairs_are_not_parallel(frame):
+    """The undercoat's hairs (along its texture's v, across its u) lean this way and that
+    over the face, a quarter of it by more than 6 degrees from straight down (u the arc
+    round the face alone: under a degree, every hair parallel, corduroy)."""
+    body, (centre, *_) = frame
+    mesh = face.beard_undercoat(body).mesh
+    tri = mesh.vertices[mesh.faces[:, :3]].astype(np.float64)
+    u = mesh.uvs[mesh.face_uvs[:, :3], 0].astype(np.float64)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    normal = np.cross(e1, e2)
+    # u's gradient in each triangle's plane; the hairs run across it.
+    du = np.stack([u[:, 1] - u[:, 0], u[:, 2] - u[:, 0], np.zeros(len(u))], 1)
+    grad = np.linalg.solve(np.stack([e1, e2, normal], 1), du[..., None])[..., 0]
+    hair = np.cross(normal, grad)
+    hair /= np.linalg.norm(hair, axis=1, keepdims=True)
+    rel = tri.mean(axis=1) - centre
+    round_ = np.stack([-rel[:, 1], rel[:, 0], np.zeros(len(rel))], 1)
+    round_ /= np.linalg.norm(round_, axis=1, keepdims=True)
+    lean = np.degrees(np.arcsin(np.clip(np.abs(np.einsum("fd,fd->f", hair, round_)), 0, 1)))
+    assert np.percentile(lean, 75) > 6, np.percentile(lean, 75)

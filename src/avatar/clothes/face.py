@@ -14,7 +14,14 @@ from avatar.body.model import BODY_VERTICES
 from avatar.clothes.authoring import AuthoringBody, Piece, bound, cut, join, single_references
 from avatar.clothes.hair import around, cards_on, head_frame, per_corner
 from avatar.geometry.shell import boundary_edges
-from avatar.looks.facial_hair import CHEEK_DEG, CHEEK_M, EDGE_M, WOBBLE_M  # noqa: F401
+from avatar.looks.facial_hair import (  # noqa: F401
+    CHEEK_DEG,
+    CHEEK_M,
+    EDGE_M,
+    WOBBLE_M,
+    beard_edge,
+    cheek_wobble,
+)
 from avatar.mesh import Mesh, vertex_normals
 
 
@@ -217,8 +224,9 @@ def mouth_frame(body: AuthoringBody) -> tuple[np.ndarray, np.ndarray, float, flo
 
 def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> np.ndarray:
     """(N,) how densely facial hair grows at ``points`` (N, 3) on the skin, 0..1: 1 well
-    inside, falling off smoothly over ``EDGE_M`` (1 cm) at every edge, along a line that
-    wanders by a few millimetres (a beard's edge is neither straight nor sharp).
+    inside, falling off smoothly at every edge (over ``EDGE_M``, 1 cm; up the cheeks over
+    ``CHEEK_FADE_M``, ``looks.facial_hair.cheek_fade``), along a line that wanders by a
+    few millimetres (a beard's edge is neither straight nor sharp).
 
     part "beard": chin, jaw, cheeks below the cheek line (``CHEEK_*``), sideburns,
     moustache and the throat under the chin; "moustache": the upper lip from under the
@@ -239,17 +247,8 @@ def facial_hair_density(body: AuthoringBody, part: str, points: np.ndarray) -> n
             * _soft((rel_z - bottom) / 0.002)
             * _soft((1 - across) / 0.12)
         )
-    angle = np.radians(turn)
-    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
-    top = np.interp(turn, CHEEK_DEG, CHEEK_M) + wobble
-    under = points[:, 2] - (chin_z - 0.02) + 0.5 * wobble  # the throat, down 2 cm
-    back = np.radians(88 - turn) * 0.08  # m round the head in front of the ear
-    return (
-        _soft((top - rel_z) / EDGE_M)
-        * _soft(under / EDGE_M)
-        * _soft(back / (0.6 * EDGE_M))
-        * (points[:, 2] < eye_z)
-    )
+    under = points[:, 2] - (chin_z - 0.02) + 0.5 * cheek_wobble(turn)  # the throat, down 2 cm
+    return beard_edge(turn, rel_z) * _soft(under / EDGE_M) * (points[:, 2] < eye_z)
 
 
 MOUSTACHE_HALF_M = 0.028  # from the middle of the lip to the corner of the mouth
@@ -341,7 +340,7 @@ def beard_undercoat(body: AuthoringBody) -> Piece:
     centre, *_ = mouth_frame(body)
     p = mesh.vertices.astype(np.float64)
     angle = np.arctan2(p[:, 0], -(p[:, 1] - centre[1]))
-    u = angle * fh.ARC_RADIUS_M / UNDERCOAT_TILE_M
+    u = (angle * fh.ARC_RADIUS_M + undercoat_wave(angle, p[:, 2])) / UNDERCOAT_TILE_M
     # Where the beard is full, v also climbs up the face (within the fully covered rows):
     # at one v the texture's tangent along v (the hairs' direction for the anisotropic
     # highlight) was undefined, and the chin shone as one smooth shell.
@@ -352,12 +351,25 @@ def beard_undercoat(body: AuthoringBody) -> Piece:
     return bound(body, per_corner(mesh, uv.astype(np.float32)), faces)
 
 
+UNDERCOAT_WAVE_M = 0.0012  # how far the undercoat's hairs wander sideways (m)
+
+
+def undercoat_wave(angle: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(N,) m the undercoat's u moves round the face at ``angle`` (radians round the
+    head) and height ``z`` (m): two waves up the face whose phase turns round it, so its
+    hairs lean some 10-20 degrees this way and that, patch by patch (u the arc alone
+    combed every hair straight down the face, parallel, as corduroy's wales run)."""
+    return UNDERCOAT_WAVE_M * (0.6 * np.sin(2 * np.pi * z / 0.021 + 3.1 * angle)
+                               + 0.4 * np.sin(2 * np.pi * z / 0.013 - 5.3 * angle + 1.1))
+
+
 def beard_cards(body: AuthoringBody, count: int = 2200, length=(0.007, 0.013)) -> Piece:
     """A short beard's strand cards rooted where ``facial_hair_density(body, "beard",
     ...)`` lets them grow, combed down the face, about a centimetre long, lying close to
     the skin, thinning out (sparser, shorter, flatter) over the last centimetre to its
-    edges. The hair above the mouth (the moustache) and the rest are bound apart: one
-    rides the upper lip, the other the jaw, so opening the mouth parts them.
+    edges (up the cheeks over some two: ``looks.facial_hair.cheek_fade``). The hair
+    above the mouth (the moustache) and the rest are bound apart: one rides the upper
+    lip, the other the jaw, so opening the mouth parts them.
 
     One segment a card (4 vertices: a centimetre-long card bends over the jaw by a tenth
     of a millimetre between its ends)."""

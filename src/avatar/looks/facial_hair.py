@@ -26,6 +26,14 @@ CHEEK_DEG = (0, 10, 18, 24, 32, 45, 58, 70, 80, 88)
 CHEEK_M = (0.017, 0.014, 0.006, 0.004, 0.012, 0.024, 0.036, 0.05, 0.062, 0.066)
 EDGE_M = 0.01  # the beard thins out over this band at its edges (density 1 -> 0)
 WOBBLE_M = 0.004  # how far the edge wanders off the line (irregular, as hair grows)
+# ... but on the cheeks (between the CHEEK_FADE_DEG pairs, blending from EDGE_M at the
+# corner of the mouth and the sideburns) over CHEEK_FADE_M up the face, some 1.6 cm
+# across the slanted line on the skin: over EDGE_M its 10-90 % fall-off measured 4.4 mm
+# on the skin, and the cheek line read as drawn with a pen. The fade grows down into
+# the beard; its bare end rises only CHEEK_RAISE_M (no hair on the cheekbones).
+CHEEK_FADE_M = 0.036
+CHEEK_FADE_DEG = (18, 32, 72, 86)
+CHEEK_RAISE_M = 0.002
 ARC_RADIUS_M = 0.075  # stubble u: arc length round the face at about this radius
 
 # The stubble atlas: u over [-SPAN_U, SPAN_U] m of arc, v over [V_LOW, V_HIGH] m from the
@@ -53,16 +61,32 @@ def _soft(x: np.ndarray) -> np.ndarray:
     return t * t * (3 - 2 * t)
 
 
-def beard_edge(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
-    """(N,) density of a full beard from its upper (cheek) line and its back edge in front
-    of the ears, 0..1, falling off over ``EDGE_M``: turn_deg, degrees round the head from
-    the front (absolute); rel_z, m above the mouth. (The throat's edge depends on the chin:
-    ``clothes.face.facial_hair_density``.)"""
+def cheek_wobble(turn_deg: np.ndarray) -> np.ndarray:
+    """(N,) m the beard's edges wander off their lines at ``turn_deg`` round the head."""
     angle = np.radians(turn_deg)
-    wobble = WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
-    top = np.interp(turn_deg, CHEEK_DEG, CHEEK_M) + wobble
+    return WOBBLE_M * (0.6 * np.sin(7.0 * angle + 1.3) + 0.4 * np.sin(17.0 * angle + 0.4))
+
+
+def cheek_fade(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
+    """(N,) density of a full beard under its upper (cheek) line, 0..1: turn_deg, degrees
+    round the head from the front (absolute); rel_z, m above the mouth. It thins out over
+    ``EDGE_M`` up the face by the mouth and the sideburns, over ``CHEEK_FADE_M`` on the
+    cheeks (``CHEEK_FADE_DEG``), bare from ``EDGE_M / 2`` (plus ``CHEEK_RAISE_M`` on the
+    cheeks) above the wandering line."""
+    top = np.interp(turn_deg, CHEEK_DEG, CHEEK_M) + cheek_wobble(turn_deg)
+    wide = np.interp(turn_deg, CHEEK_FADE_DEG, (0.0, 1.0, 1.0, 0.0))
+    width = EDGE_M + wide * (CHEEK_FADE_M - EDGE_M)
+    bare = top + EDGE_M / 2 + wide * CHEEK_RAISE_M
+    return _soft((bare - width / 2 - rel_z) / width)
+
+
+def beard_edge(turn_deg: np.ndarray, rel_z: np.ndarray) -> np.ndarray:
+    """(N,) density of a full beard from its upper (cheek) line (``cheek_fade``) and its
+    back edge in front of the ears, 0..1: turn_deg, degrees round the head from the front
+    (absolute); rel_z, m above the mouth. (The throat's edge depends on the chin:
+    ``clothes.face.facial_hair_density``.)"""
     back = np.radians(88 - turn_deg) * 0.08
-    return _soft((top - rel_z) / EDGE_M) * _soft(back / (0.6 * EDGE_M))
+    return cheek_fade(turn_deg, rel_z) * _soft(back / (0.6 * EDGE_M))
 
 
 def grey_share(age: float) -> float:
@@ -109,8 +133,11 @@ def beard_material(spec, size: int = 1024) -> Material:
     colour[: size - half, :, 3] = undercoat_alpha(size - half, size, hair, rng)
     # The undercoat is the hair deep in the beard, in the shade of the clumps over it:
     # as light as the cards, the gaps between clumps did not show and the beard read as
-    # one even mat.
-    under = colour[: size - half, :, :3].astype(np.float32)
+    # one even mat. Its hairs in their own shades (``undercoat_shade``): the hair
+    # layout's dense rows keep one lock's shade down a whole column, which the undercoat
+    # stretches down the whole face: fine parallel stripes, corduroy.
+    rgb = fabrics.rgb(spec.colour)[None, None, :] * undercoat_shade(size - half, size, rng)
+    under = _lifted(fabrics.srgb(rgb), fabrics.rgb(spec.colour)).astype(np.float32)
     colour[: size - half, :, :3] = np.round(under * UNDERCOAT_SHADE).astype(np.uint8)
     # No normal map, and the undercoat's roughness even: the hair fabric's grooves run
     # the texture's whole height, and on the undercoat, mapped up the face with v
@@ -207,6 +234,45 @@ def undercoat_alpha(rows: int, size: int, hair: int, rng) -> np.ndarray:
     low, high = UNDERCOAT_V
     share = np.clip((v - low) / (high - low), 0, 1)[:, None]
     return np.where(rank < share * 1.02, 255, 0).astype(np.uint8)
+
+
+# The undercoat's shading (``undercoat_shade``): hairs of UNDERCOAT_HAIR_ROWS (of the
+# texture's height; ~1 cm up the face where the beard is full) times 0.5..1.5, each of its
+# own shade (UNDERCOAT_HAIR_SPREAD), in locks UNDERCOAT_LOCKS across the texture's width
+# and one hair's length tall, staggered lock to lock, shaded UNDERCOAT_LOCK_SPREAD.
+UNDERCOAT_HAIR_ROWS = 1 / 96
+UNDERCOAT_HAIR_SPREAD = 0.25
+UNDERCOAT_LOCKS = 32
+UNDERCOAT_LOCK_SPREAD = 0.2
+
+
+def undercoat_shade(rows: int, size: int, rng) -> np.ndarray:
+    """(rows, size, 1) float32 brightness of a beard's undercoat rows (row 0: v = 1),
+    about 0.72 (the hair layout's dense rows): short hairs of random lengths down each
+    column, each of its own shade, in locks that change shade along the hair's length as
+    well as across it. (Locks one shade down the whole column, as the scalp's dense rows
+    have them, ran as parallel stripes down the beard.)"""
+    seg = max(size * UNDERCOAT_HAIR_ROWS, 1.0)
+    # Hair ends down each column at random spacing: 0.5..1.5 of a hair's length.
+    count = int(rows / (0.5 * seg)) + 2
+    ends = np.cumsum(rng.uniform(0.5, 1.5, (count, size)) * seg, axis=0)
+    ends -= rng.uniform(0, seg, size)[None, :]
+    hair = np.empty((rows, size), np.int64)
+    for c in range(size):
+        hair[:, c] = np.searchsorted(ends[:, c], np.arange(rows), side="right")
+    hair = hair * size + np.arange(size)[None, :]
+    own = rng.uniform(1 - UNDERCOAT_HAIR_SPREAD, 1 + UNDERCOAT_HAIR_SPREAD, hair.max() + 1)
+    # Locks: a coarse random grid, smooth in both directions, each lock column's knots
+    # at their own rows (no lock boundaries lining up across the beard).
+    knots = rng.uniform(1 - UNDERCOAT_LOCK_SPREAD, 1 + UNDERCOAT_LOCK_SPREAD,
+                        (int(rows / seg) + 3, UNDERCOAT_LOCKS))  # fmt: skip
+    phase = rng.uniform(0, 1, UNDERCOAT_LOCKS)
+    at = np.arange(rows)[:, None] / seg + phase[None, :]
+    along = np.stack([np.interp(at[:, j], np.arange(len(knots)), knots[:, j])
+                      for j in range(UNDERCOAT_LOCKS)], 1)  # fmt: skip
+    lock_u = np.arange(UNDERCOAT_LOCKS) * size / UNDERCOAT_LOCKS
+    locks = np.stack([np.interp(np.arange(size), lock_u, row, period=size) for row in along])
+    return (0.72 * locks * own[hair])[..., None].astype(np.float32)
 
 
 def stubble_alpha(size: int, seed: int = 0) -> np.ndarray:
