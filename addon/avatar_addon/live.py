@@ -200,6 +200,33 @@ def change_rig(root, rig: str) -> None:
     sync_from_recipe(built.root)
 
 
+def change_eyes(root, colour: str) -> None:
+    """Another iris colour: only the eyes' material changes (``character.set_looks``)."""
+    if root.name_full in _SUSPENDED:
+        return
+    from avatar.blender import character
+    from avatar.errors import AvatarError
+
+    try:
+        character.set_looks(root, eye_material=f"eyes/materials/{colour}.mhmat")
+    except AvatarError as exc:
+        root[ERROR_KEY] = str(exc)
+        log.error("Avatar: %s", exc)
+
+
+def _eye_colour(eye_material) -> str:
+    """The Eyes menu's entry for a recipe's eye material (MakeHuman's names mapped)."""
+    from pathlib import Path
+
+    from avatar.human import EYE_COLOURS
+
+    from .properties import EYES
+
+    stem = Path(eye_material or "brown").stem.lower()
+    colour = EYE_COLOURS.get(stem, "brown")
+    return colour if colour in EYES else "brown"
+
+
 def sync_from_recipe(root) -> None:
     """Set ``root.avatar`` from the stored recipe (no update runs): after a create, a
     rebuild, a preset or an undo of something the properties do not hold."""
@@ -218,6 +245,9 @@ def sync_from_recipe(root) -> None:
             setattr(props, f"pca_{a}", params.get(f"pca/{a}", 0.0))
         if recipe.get("rig") and recipe["rig"] != props.rig:
             props.rig = recipe["rig"]
+        eyes = _eye_colour(recipe.get("eye_material"))
+        if eyes != props.eyes:
+            props.eyes = eyes
         if len(props.modifiers) == 0:
             for name, label, group, minimum in catalogue.modifier_rows():
                 item = props.modifiers.add()

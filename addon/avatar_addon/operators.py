@@ -358,8 +358,30 @@ class AVATAR_OT_refresh_library(bpy.types.Operator):
         return _call(self, lambda: f"{refresh_garments(context.scene.avatar)} garments")
 
 
+class AVATAR_OT_set_skin(_OnCharacter, bpy.types.Operator):
+    """Give the character this MakeHuman skin, or Avatar's own (by ethnicity, age and gender)"""
+
+    bl_idname = "avatar.set_skin"
+    bl_label = "Set Skin"
+
+    path: StringProperty(name="Skin", description="A skin .mhmat; empty: Avatar's own skin")
+
+    def execute(self, context):
+        from avatar.blender import character
+
+        root = _active_root(context)
+
+        def set_skin():
+            character.set_looks(root, skin_material=self.path or None)
+            return f"Skin: {os.path.basename(self.path) if self.path else 'Avatar'}"
+
+        return _call(self, set_skin)
+
+
 def refresh_garments(settings):
-    """Fill the Dress panel's list from the library; returns how many it holds."""
+    """Fill the Dress panel's list from the library (and the Body panel's skins); returns
+    how many garments it holds."""
+    catalogue.skins.cache_clear()
     items = settings.garments
     items.clear()
     for name, category, entry, thumbnail in catalogue.garments():
@@ -532,6 +554,7 @@ CLASSES = (
     AVATAR_OT_export_mhm,
     AVATAR_OT_toggle_group,
     AVATAR_OT_refresh_library,
+    AVATAR_OT_set_skin,
     AVATAR_OT_wear,
     AVATAR_OT_take_off,
     AVATAR_OT_toggle_garment,

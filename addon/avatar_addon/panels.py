@@ -51,6 +51,7 @@ class AVATAR_PT_body(_AvatarPanel, bpy.types.Panel):
         column = box.column(align=True)
         for name in RACES:
             column.prop(props, name, slider=True)
+        _draw_skin_and_eyes(layout, root, props)
         layout.label(text="Attributes (standard deviations)")
         column = layout.column(align=True)
         for name in ATTRIBUTES:
@@ -60,6 +61,27 @@ class AVATAR_PT_body(_AvatarPanel, bpy.types.Panel):
         _draw_locals(layout, props, settings)
         _draw_expressions(layout, props, settings)
         _draw_body_tools(layout, settings)
+
+
+def _draw_skin_and_eyes(layout, root, props):
+    """Eyes, and the skin: Avatar's own, or one of the user's textured MakeHuman skins,
+    each with its ``.thumb``."""
+    box = layout.box()
+    box.prop(props, "eyes")
+    skins = catalogue.skins()
+    current = json.loads(root["avatar_recipe"]).get("skin_material") or ""
+    if not skins:
+        box.label(text="Skin: Avatar's (ethnicity, age)")
+        return
+    box.label(text="Skin")
+    grid = box.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
+    for name, path, thumbnail in (("Avatar", "", ""), *skins):
+        cell = grid.column(align=True)
+        icon = thumbnails.skin_icon(path, thumbnail) if thumbnail else 0
+        if icon:
+            cell.template_icon(icon_value=icon, scale=2.5)
+        op = cell.operator("avatar.set_skin", text=name, depress=path == current)
+        op.path = path
 
 
 def _draw_measurements(layout, props, settings):

@@ -62,6 +62,14 @@ def _rig_changed(self, context):
     live.change_rig(self.id_data, self.rig)
 
 
+def _eyes_changed(self, context):
+    live.change_eyes(self.id_data, self.eyes)
+
+
+# Avatar's iris colours (``looks.skin.IRIS_SRGB``), as MakeHuman names its eye materials.
+EYES = ("brown", "dark_brown", "hazel", "green", "blue", "grey")
+
+
 class AvatarModifier(bpy.types.PropertyGroup):
     """A local modifier (MakeHuman name) or face unit (``expression/...``) and its value."""
 
@@ -82,6 +90,8 @@ class AvatarCharacter(bpy.types.PropertyGroup):
         "modifiers": CollectionProperty(type=AvatarModifier),
         "rig": EnumProperty(name="Rig", update=_rig_changed,
                             items=[(r, r.replace("_", " ").title(), "") for r in RIGS]),
+        "eyes": EnumProperty(name="Eyes", update=_eyes_changed, default="brown",
+                             items=[(e, e.replace("_", " ").title(), "") for e in EYES]),
         # The body's measurements (cm), refreshed when the character settles.
         "measured_height": FloatProperty(name="Height", subtype="NONE", precision=1),
         "measured_chest": FloatProperty(name="Chest", precision=1),

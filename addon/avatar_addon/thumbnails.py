@@ -45,6 +45,7 @@ class Previews:
 
 
 _DRESS = Previews()  # the Dress panel's library icons
+_SKINS = Previews()  # the Body panel's skin icons (their own .thumb files)
 _WAITING: set[str] = set()  # entries whose picture is being drawn (a swatch or no icon)
 _QUEUE: list[str] = []  # entries to draw, started together by ``draw_queued``
 _DRAWER: list[subprocess.Popen] = []  # the processes drawing the missing pictures
@@ -54,6 +55,7 @@ POLL_S = 1.0
 def release() -> None:
     """Close the icons, stop the drawing processes and their timer (unregister)."""
     _DRESS.release()
+    _SKINS.release()
     _WAITING.clear()
     _QUEUE.clear()
     if bpy.app.timers.is_registered(_swap_pictures):
@@ -82,6 +84,16 @@ def icon(entry: str, thumbnail: str) -> int:
     if not path:
         return 0
     return previews.load(entry, path, "IMAGE").icon_id
+
+
+def skin_icon(path: str, thumbnail: str) -> int:
+    """The preview icon id of a skin's own ``.thumb`` (0 when it cannot be read)."""
+    previews = _SKINS.get()
+    if path not in previews:
+        if not os.path.isfile(thumbnail):
+            return 0
+        previews.load(path, thumbnail, "IMAGE")
+    return previews[path].icon_id
 
 
 def _picture(entry: str) -> str:

@@ -464,7 +464,7 @@ class Human:
         if part in ("teeth", "tongue"):
             age = (self.model.defaults() | self.recipe.params)["age"]
             return skin.mouth_material(part, age=age)
-        found = self._skin_file()
+        found = self.skin_file()
         if found is not None:
             loaded = material_from_file(found)
             if loaded.base_color_texture is not None:
@@ -483,7 +483,7 @@ class Human:
             log.warning("eye material %s: unknown colour, brown eyes", self.recipe.eye_material)
         return EYE_COLOURS.get(stem, "brown")
 
-    def _skin_file(self) -> Path | None:
+    def skin_file(self) -> Path | None:
         """The recipe's skin ``.mhmat``: as given, or under an asset folder (also without
         MakeHuman's ``skins/`` prefix); None for the default skin or when not found."""
         name = self.recipe.skin_material

@@ -157,6 +157,97 @@ def test_skin_follows_ethnicity_once_settled_and_old_material_goes(human):
     assert len(bpy.data.images) == images
 
 
+def _user_skin(folder: Path, name: str, rgb, texture: bool = True) -> Path:
+    """A MakeHuman skin in ``folder``/skins/``name``: a one-colour diffuse texture and a
+    ``.thumb``, as MakeHuman ships them (``texture=False``: the texture line only)."""
+    from avatar.io import png
+
+    skin = folder / "skins" / name
+    skin.mkdir(parents=True)
+    image = np.zeros((64, 64, 3), np.uint8) + np.array(rgb, np.uint8)
+    if texture:
+        png.write(skin / f"{name}_diffuse.png", image)
+    png.write(skin / f"{name}.thumb", image)
+    (skin / f"{name}.mhmat").write_text(f"name {name}\ndiffuseColor 1 1 1\n"
+                                        f"diffuseTexture {name}_diffuse.png\n")  # fmt: skip
+    return skin / f"{name}.mhmat"
+
+
+def _texels(obj) -> np.ndarray:
+    """(N, 3) the colours (0..1) of the image in ``obj``'s material (its first)."""
+    image = next(n.image for n in obj.data.materials[0].node_tree.nodes
+                 if n.type == "TEX_IMAGE" and n.image is not None)  # fmt: skip
+    pixels = np.empty(len(image.pixels), np.float32)
+    image.pixels.foreach_get(pixels)
+    return pixels.reshape(-1, image.channels)[:, :3]
+
+
+def _texture_mean(obj) -> np.ndarray:
+    return _texels(obj).mean(axis=0)
+
+
+def test_a_users_makehuman_skin_is_listed_and_worn_and_a_broken_one_changes_nothing(
+        human, tmp_path, monkeypatch):  # fmt: skip
+    """The Body panel lists the user's textured MakeHuman skins (from their asset folders,
+    with their ``.thumb``); a click puts one on, it stays through a settle (ethnicity no
+    longer repaints it), "Avatar" gives the procedural skin back; a skin whose texture is
+    missing is an error report that leaves the skin as it was."""
+    import importlib
+
+    import bpy
+    from extension_fixtures import ADDON
+
+    from avatar.blender import live
+
+    catalogue = importlib.import_module(f"{ADDON}.catalogue")
+    tanned = _user_skin(tmp_path, "tanned", (150, 90, 60))
+    broken = _user_skin(tmp_path / "broken", "broken", (0, 0, 0), texture=False)
+    monkeypatch.setenv("AVATAR_CLOTHES_PATH", str(tmp_path))  # finds skins/ below, too
+    catalogue.skins.cache_clear()
+    try:
+        assert [s[:2] for s in catalogue.skins()] == [("tanned", str(tanned))]  # not broken
+        assert catalogue.skins()[0][2].endswith("tanned.thumb")
+        body = live.part_objects(human)["body"]
+        own = body.data.materials[0].name
+        assert bpy.ops.avatar.set_skin(path=str(tanned)) == {"FINISHED"}
+        assert np.allclose(_texture_mean(body), np.array([150, 90, 60]) / 255, atol=0.02)
+        assert json.loads(human["avatar_recipe"])["skin_material"] == str(tanned)
+        human.avatar.african = 0.8
+        bpy.ops.avatar.settle()
+        assert np.allclose(_texture_mean(body), np.array([150, 90, 60]) / 255, atol=0.02)
+        worn = body.data.materials[0].name
+        with pytest.raises(RuntimeError, match="diffuse"):
+            bpy.ops.avatar.set_skin(path=str(broken))
+        assert body.data.materials[0].name == worn
+        assert json.loads(human["avatar_recipe"])["skin_material"] == str(tanned)
+        assert bpy.ops.avatar.set_skin(path="") == {"FINISHED"}
+        assert body.data.materials[0].name != worn and not json.loads(
+            human["avatar_recipe"]).get("skin_material")  # fmt: skip
+        assert own  # (the procedural skin's name changes with ethnicity)
+    finally:
+        catalogue.skins.cache_clear()
+
+
+def test_eye_colour_changes_only_the_eyes(human):
+    """Eyes: a menu of iris colours; picking one changes the eyes' material at once (the
+    body and garments are not rebuilt) and the recipe names MakeHuman's eye material."""
+    from avatar.blender import live
+
+    parts = live.part_objects(human)
+    eyes, body = parts["eyes"], parts["body"]
+    before = _texels(eyes)
+    skin, vertices = body.data.materials[0], body.data.vertices[0].co.copy()
+    human.avatar.eyes = "blue"
+    after = _texels(eyes)
+    iris = np.abs(after - before).max(axis=1) > 0.05  # the texels that changed
+    assert iris.sum() > 1000, iris.sum()
+    was, now = before[iris].mean(axis=0), after[iris].mean(axis=0)
+    assert now[2] > now[0] + 0.1 and was[2] < was[0], (was, now)  # brown to blue
+    assert body.data.materials[0] == skin and body.data.vertices[0].co == vertices
+    assert json.loads(human["avatar_recipe"])["eye_material"] == "eyes/materials/blue.mhmat"
+    human.avatar.eyes = "brown"
+
+
 def test_several_humans_coexist(installed, assets, empty_scene):
     import bpy
 

@@ -104,6 +104,18 @@ if [[ -d "$USER_SHOES" ]]; then
   rm "$WORK/clothes/shoes02/shoes02.thumb"
 fi
 
+# ... and a user's textured skin (MakeHuman's layout: skins/NAME/NAME.mhmat, .thumb), made
+# here: the Body panel lists it with its thumbnail.
+mkdir -p "$WORK/clothes/skins/tanned"
+"$PY" - "$WORK/clothes/skins/tanned" <<'SKIN'
+import sys
+from PIL import Image
+folder = sys.argv[1]
+Image.new("RGB", (64, 64), (150, 90, 60)).save(f"{folder}/tanned_diffuse.png")
+Image.new("RGB", (64, 64), (150, 90, 60)).save(f"{folder}/tanned.thumb", format="PNG")
+open(f"{folder}/tanned.mhmat", "w").write("name tanned\ndiffuseTexture tanned_diffuse.png\n")
+SKIN
+
 AVATAR_CLOTHES_PATH="$WORK/clothes" \
 AVATAR_UI_BVH="${AVATAR_UI_BVH:-$ROOT/../shared/fixtures/bvh/cmu_motionbuilder/02_01_walk.bvh}" \
 AVATAR_UI_OUT="$OUT" BLENDER_USER_SCRIPTS="$WORK/scripts" BLENDER_USER_CONFIG="$WORK/config" \

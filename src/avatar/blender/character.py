@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 from pathlib import Path
 
 import bpy
@@ -112,6 +113,37 @@ def _restyle(root: bpy.types.Object, recipe: Recipe) -> stage.CharacterObjects:
     root[live.SETTLED_KEY] = 1
     garment_looks.apply(root)
     return objects_of(root)
+
+
+def set_looks(obj: bpy.types.Object, **looks: str | None) -> None:
+    """Give the character ``obj`` belongs to another skin or eye material
+    (``skin_material``: a MakeHuman skin ``.mhmat``, None for Avatar's own;
+    ``eye_material``: e.g. ``eyes/materials/blue.mhmat``). Only materials change, so it
+    is instant; the new ones are made first, so a broken skin file (AvatarError) leaves
+    the character as it was."""
+    root = root_of(obj)
+    if root is None:
+        raise AvatarError(f"{obj.name!r} is not part of an Avatar character")
+    unknown = set(looks) - {"skin_material", "eye_material"}
+    if unknown:
+        raise AvatarError(f"set_looks takes skin_material and eye_material, not {unknown}")
+    human = Human.from_recipe(replace(live.recipe_of(root), **looks))
+    if human.recipe.skin_material:
+        _check_skin(human)
+    live.refresh_materials(root, human)
+    root[RECIPE_KEY] = json.dumps(human.to_recipe())
+
+
+def _check_skin(human: Human) -> None:
+    """A skin the recipe names must load with its texture (``Human.material`` would fall
+    back to Avatar's skin, silently, where the user asked for this one)."""
+    from avatar.clothes.asset import material_from_file
+
+    path = human.skin_file()
+    if path is None:
+        raise AvatarError(f"{human.recipe.skin_material}: no such skin material file")
+    if material_from_file(path).base_color_texture is None:
+        raise AvatarError(f"{path}: the skin has no diffuse texture")
 
 
 def objects_of(root: bpy.types.Object) -> stage.CharacterObjects:

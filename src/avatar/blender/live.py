@@ -429,14 +429,13 @@ def refresh_materials(root: bpy.types.Object, human: Human) -> None:
     on ethnicity, age and gender), and the worn built-ins theirs (``worn_looks``: brows,
     facial hair and hair grey with age); the old ones go when nothing else uses them."""
     parts = part_objects(root)
-    for name in PART_GROUPS:
-        obj = parts.get(name)
-        if obj is not None:
-            _swap_material(obj, material_bridge.material(human.material(name), name))
-    for name, look in worn_looks(human.recipe, human.model).items():
-        obj = parts.get(name)
-        if obj is not None and obj.type == "MESH":
-            _swap_material(obj, material_bridge.material(look, name))
+    # Every material is made before any is swapped: a skin file that fails to load leaves
+    # the character as it was.
+    looks = {name: human.material(name) for name in PART_GROUPS if name in parts}
+    looks |= {name: look for name, look in worn_looks(human.recipe, human.model).items()
+              if name in parts and parts[name].type == "MESH"}  # fmt: skip
+    for name, look in looks.items():
+        _swap_material(parts[name], material_bridge.material(look, name))
 
 
 def _swap_material(obj: bpy.types.Object, new: bpy.types.Material) -> None:
