@@ -264,6 +264,10 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     mesh = _toe_box(body, foot, mesh, CAP_EASE, smooth_rim=6)
     mesh = _drawn_down(body, foot, mesh, reach=OPEN_BOTTOM)
     mesh = _faired(body, mesh, CAP_EASE)
+    # Split in four and faired again: faired at the last's resolution the nose still turned
+    # up to 43 degrees between neighbouring faces (21 for one edge in twenty), and the
+    # shading's interpolated normals drew blotchy highlights on dark leather.
+    mesh = _faired(body, _subdivided(mesh), CAP_EASE)
     return bound(body, _cap_uvs(_skived(mesh, foot), foot), faces)
 
 
@@ -634,8 +638,11 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         pieces.append(bound(body, _planar_uvs(tongue, "upper", LACING_BAND), faces))
     facings = []
     for side in (-1, 1):
-        across = [half - 0.005, half + 0.002, half + 0.009]
-        grid = np.stack([np.column_stack([x + side * a, along]) for a in across], 1)
+        # Columns from -x to +x, so both facings' faces face up: the inner one's faced down,
+        # its shell's outer layer seen from behind, the grain's highlights inverted (a pale
+        # speckled sheen down it, brightest at its front end).
+        across = np.sort(side * np.array([half - 0.005, half + 0.002, half + 0.009]), axis=0)
+        grid = np.stack([np.column_stack([x + a, along]) for a in across], 1)
         sheet = _sheet(surface, grid, FACING_LIFT)
         if sheet is not None:
             facings.append(sheet)
@@ -722,11 +729,12 @@ def shaft_lacing(body: AuthoringBody, surface: _Surface, plan: Lacing, rows: Sha
     half = np.interp(z, rows.z, rows.half)
 
     def sheet(across: np.ndarray, lift: float) -> Mesh:  # a grid up the shaft's front
+        across = np.sort(across, axis=1)  # columns from -x to +x: faces facing forward (-y)
         xz = np.stack([np.column_stack([x + a, z]) for a in across.T], 1)  # (R, C, 2)
         points, _ = _front(surface, xz.reshape(-1, 2), lift)
         r, c = xz.shape[:2]
         idx = np.arange(r * c).reshape(r, c)
-        quads = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1)
+        quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], -1)
         return Mesh(points.astype(np.float32), quads.reshape(-1, 4).astype(np.int32))
 
     facings = [sheet(side * (half[:, None] + np.array([[-0.005, 0.009]])), FACING_LIFT)
@@ -745,7 +753,7 @@ def _front_disc(surface: _Surface, xz: np.ndarray, radius: float) -> Mesh:
     angle = np.linspace(0, 2 * np.pi, 6, endpoint=False)
     ring = xz + radius * np.column_stack([np.cos(angle), np.sin(angle)])
     points, _ = _front(surface, ring, EYELET_LIFT)
-    faces = [[0, 3, 2, 1], [0, 5, 4, 3]]  # facing forward (-y)
+    faces = [[0, 1, 2, 3], [0, 3, 4, 5]]  # counter-clockwise in xz: facing forward (-y)
     return Mesh(points.astype(np.float32), np.array(faces, np.int32))
 
 
