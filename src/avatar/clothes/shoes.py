@@ -264,10 +264,19 @@ def toe_cap(body: AuthoringBody, foot: Foot) -> Piece:
     mesh = _toe_box(body, foot, mesh, CAP_EASE, smooth_rim=6)
     mesh = _drawn_down(body, foot, mesh, reach=OPEN_BOTTOM)
     mesh = _faired(body, mesh, CAP_EASE)
+    # The nose split in four and faired again: faired at the last's resolution it still
+    # turned up to 43 degrees between neighbouring faces (21 for one edge in twenty), and
+    # the shading's interpolated normals drew blotchy highlights on dark leather.
+    nose = foot.along(mesh.vertices[mesh.faces].astype(np.float64).mean(axis=1)) > NOSE_FROM
+    mesh = _faired(body, _subdivided(mesh, nose), CAP_EASE)
     return bound(body, _cap_uvs(_skived(mesh, foot), foot), faces)
 
 
 FAIR_PASSES = 20  # Taubin passes over the toe cap (its folds 55-70 degrees before)
+# Along the foot, where the toe cap's nose (split finer) begins. Split back to the cap's
+# sides too, its small faces there (where the toe box's wall rolls over onto its top) folded
+# over on other feet: the binding's closest points jump across the helper's edge there.
+NOSE_FROM = 0.92
 
 
 def _faired(body: AuthoringBody, mesh: Mesh, ease: float) -> Mesh:
@@ -634,8 +643,11 @@ def lacing(body: AuthoringBody, foot: Foot, top: Piece, style: Style = SHOE) -> 
         pieces.append(bound(body, _planar_uvs(tongue, "upper", LACING_BAND), faces))
     facings = []
     for side in (-1, 1):
-        across = [half - 0.005, half + 0.002, half + 0.009]
-        grid = np.stack([np.column_stack([x + side * a, along]) for a in across], 1)
+        # Columns from -x to +x, so both facings' faces face up: the inner one's faced down,
+        # its shell's outer layer seen from behind, the grain's highlights inverted (a pale
+        # speckled sheen down it, brightest at its front end).
+        across = np.sort(side * np.array([half - 0.005, half + 0.002, half + 0.009]), axis=0)
+        grid = np.stack([np.column_stack([x + a, along]) for a in across], 1)
         sheet = _sheet(surface, grid, FACING_LIFT)
         if sheet is not None:
             facings.append(sheet)
@@ -722,11 +734,12 @@ def shaft_lacing(body: AuthoringBody, surface: _Surface, plan: Lacing, rows: Sha
     half = np.interp(z, rows.z, rows.half)
 
     def sheet(across: np.ndarray, lift: float) -> Mesh:  # a grid up the shaft's front
+        across = np.sort(across, axis=1)  # columns from -x to +x: faces facing forward (-y)
         xz = np.stack([np.column_stack([x + a, z]) for a in across.T], 1)  # (R, C, 2)
         points, _ = _front(surface, xz.reshape(-1, 2), lift)
         r, c = xz.shape[:2]
         idx = np.arange(r * c).reshape(r, c)
-        quads = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1)
+        quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], -1)
         return Mesh(points.astype(np.float32), quads.reshape(-1, 4).astype(np.int32))
 
     facings = [sheet(side * (half[:, None] + np.array([[-0.005, 0.009]])), FACING_LIFT)
@@ -745,7 +758,7 @@ def _front_disc(surface: _Surface, xz: np.ndarray, radius: float) -> Mesh:
     angle = np.linspace(0, 2 * np.pi, 6, endpoint=False)
     ring = xz + radius * np.column_stack([np.cos(angle), np.sin(angle)])
     points, _ = _front(surface, ring, EYELET_LIFT)
-    faces = [[0, 3, 2, 1], [0, 5, 4, 3]]  # facing forward (-y)
+    faces = [[0, 1, 2, 3], [0, 3, 4, 5]]  # counter-clockwise in xz: facing forward (-y)
     return Mesh(points.astype(np.float32), np.array(faces, np.int32))
 
 
@@ -758,8 +771,7 @@ def _shaft_lace(surface: _Surface, rows: ShaftRows) -> Mesh:
     a_ends = [left[i] if i % 2 == 0 else right[i] for i in range(k)]
     b_ends = [right[i] if i % 2 == 0 else left[i] for i in range(k)]
     knot = np.array([rows.x[-1], rows.z[-1] + 0.005])
-    # The bow's loops and tails in xz: _bow's xy, its tails (towards the toes) hanging down.
-    first, second = _bow(knot, rows.half[-1])
+    first, second = _boot_bow(knot)
     strips = []
     for ends, rise, loop in ((a_ends, 0.0003, first[::-1]), (b_ends, 0.0012, second)):
         path, lift = [], []
@@ -771,7 +783,7 @@ def _shaft_lace(surface: _Surface, rows: ShaftRows) -> Mesh:
         path.extend(ends[-1] + s[:, None] * (knot - ends[-1]))
         lift.extend([LACE_LIFT + 0.0008] * 3)
         path.extend(loop)
-        lift.extend([LACE_LIFT + 0.0015] * len(loop))
+        lift.extend([LACE_LIFT + BOOT_BOW_LIFT] * len(loop))  # over the top crossing
         points, normal = _front(surface, np.asarray(path), 0.0)
         strips.append(_ribbon(points + np.asarray(lift)[:, None] * normal, normal,
                               LACE_WIDTH, 0.0007))  # fmt: skip
@@ -851,6 +863,36 @@ def _bow(knot: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
 
     def tail(side: int) -> np.ndarray:  # from the knot out to its end
         return knot + np.linspace(0, 1, 3)[:, None] * [side * 0.008, -0.03]
+
+    return np.concatenate([tail(-1)[::-1], loop(-1)[1:]]), np.concatenate([loop(1), tail(1)[1:]])
+
+
+# A boot's bow, on the shaft's front under the collar: loops BOOT_LOOP m long and
+# BOOT_LOOP_WIDE across at their widest (towards their ends), drooping BOOT_DROOP radians
+# below level, and tails hanging BOOT_TAIL m down beside the lacing, BOOT_BOW_LIFT over the
+# lace. The low shoe's bow (``_bow``: level loops reaching the eyelets' half-width and
+# 12 mm more either side) put the loops' ends 31 mm out, round the side of the ankle,
+# where the shaft turned 80 degrees away: from the front two squashed slits, tails 3 cm.
+BOOT_LOOP, BOOT_LOOP_WIDE, BOOT_DROOP = 0.026, 0.019, 1.1
+BOOT_TAIL = 0.045
+BOOT_BOW_LIFT = 0.0025
+
+
+def _boot_bow(knot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first, second) xz polylines of a boot's bow (``_bow``'s order: one tail's end to
+    the knot and round its loop; the other loop, then out to its tail): teardrop loops,
+    narrow at the knot and round at their ends, drooping down the shaft's front."""
+    phi = np.linspace(0, 2 * np.pi, 12)
+    along = BOOT_LOOP * (1 - np.cos(phi)) / 2
+    across = BOOT_LOOP_WIDE / 2 * np.sin(phi) * (0.45 + 0.55 * (1 - np.cos(phi)) / 2)
+
+    def loop(side: int) -> np.ndarray:
+        axis = np.array([side * np.cos(BOOT_DROOP), -np.sin(BOOT_DROOP)])
+        normal = np.array([side * np.sin(BOOT_DROOP), np.cos(BOOT_DROOP)])
+        return knot + along[:, None] * axis + (side * across)[:, None] * normal
+
+    def tail(side: int) -> np.ndarray:  # from the knot down beside the lacing
+        return knot + np.linspace(0, 1, 4)[:, None] * [side * 0.007, -BOOT_TAIL]
 
     return np.concatenate([tail(-1)[::-1], loop(-1)[1:]]), np.concatenate([loop(1), tail(1)[1:]])
 
@@ -1355,7 +1397,12 @@ def _knit_mesh(m: Material, span: tuple[float, float], size: int, stretch: float
 CREASES = (0.67, 0.7, 0.73, 0.755)
 CREASE_TILT = 0.03
 CREASE_BEND = 0.05
-CREASE_SLOPE = 1.4  # the normal map's tilt per unit of the crease's depth per texel
+CREASE_SLOPE = 2.0  # the normal map's tilt per unit of the crease's depth per texel
+# A valley's half-width, texels at 1024 (~0.8 mm along the foot each): at 1.3 the creases
+# were a millimetre wide, their walls tilting up to 39 degrees; a full-body picture's pixel
+# (~3 mm of shoe) averaged each valley's two walls away (4 degrees RMS left: no creases).
+# At 3, steeper per unit depth: 32 degrees at most up close, 7 RMS over 3 mm.
+CREASE_WIDTH = 3.0
 
 
 def _creased(m: Material, size: int, strength: float = 1.0) -> None:
@@ -1377,7 +1424,8 @@ def _creased(m: Material, size: int, strength: float = 1.0) -> None:
         centre = (1 - np.array([vamp_v(x) for x in line])) * size - rows.start
         d = (y - centre[None]) * 1024 / size - waver[None]  # texels at 1024 off the line
         depth = np.clip(0.35 + 0.9 * _smooth_noise(rng, (1, w), max(8, w // 5))[0], 0, 1)
-        valley = np.exp(-((d / 1.3) ** 2)) - 0.3 * np.exp(-(((d + 2.2) / 1.8) ** 2))
+        d = d / CREASE_WIDTH  # valley half-widths off the line
+        valley = np.exp(-(d**2)) - 0.3 * np.exp(-(((d + 1.7) / 1.4) ** 2))
         height -= depth * across * valley
     normal[rows] = _bumped(normal[rows], height * strength * size / 1024, CREASE_SLOPE)
     shade = 1 - 0.08 * strength * np.clip(-height, 0, 1)
