@@ -123,6 +123,8 @@ def _command(draw, folder: Path) -> tuple[list[str], list[Path]]:
             ("--pose", pick([str(folder / "in.bvh"), "nope", str(folder / "in.mhm")])),
             ("--wear", pick([str(folder / "in.mhclo"), "nope", str(folder / "none.mhclo")])),
             ("--rig", pick(["nope", "default", ""])),
+            ("--skin", pick(["avatar", "nope", str(folder / "in.mhmat"), str(folder / "in.mhm")])),
+            ("--eyes", pick(["blue", "purple", ""])),
         ):
             if draw(st.integers(0, 3)) == 0:
                 argv += [flag, draw(values)]

@@ -38,3 +38,28 @@ def test_a_clothes_folder_finds_its_sibling_skins(tmp_path):
     young = _skin(data / "skins" / "young", "young")
     assert [s.path for s in list_skins([data / "clothes"])] == [str(young)]
     assert list_skins([tmp_path / "missing"]) == []
+
+
+def test_create_wears_a_skin_by_name_and_eyes_and_refuses_an_unknown_one(tmp_path, capsys):
+    """``avatar create --skin NAME --eyes blue``: the recipe (and its .mhm) names the skin
+    found in the asset folders; an unknown name or an untextured file is one line naming
+    close matches or the file, and nothing is written."""
+    from avatar import cli
+    from avatar.io import mhm
+
+    young = _skin(tmp_path / "assets" / "skins" / "young", "young")
+    out = tmp_path / "a.mhm"
+    folder = str(tmp_path / "assets")
+    assert cli.main(["create", "--skin", "young", "--eyes", "blue", "--folder", folder,
+                     "-o", str(out)]) == 0  # fmt: skip
+    text = mhm.read(out).text
+    assert text["skinMaterial"] == str(young), text
+    assert "blue" in out.read_text()
+    lost = _skin(tmp_path / "lost", "lost", texture=False)
+    for bad, named in (("yong", "young"), (str(lost), "lost_diffuse.png"),
+                       (str(tmp_path / "none.mhmat"), "none.mhmat")):  # fmt: skip
+        bad_out = tmp_path / "b.mhm"
+        assert cli.main(["create", "--skin", bad, "--folder", folder, "-o", str(bad_out)]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and named in err[0] and "Traceback" not in err[0], err
+        assert not bad_out.exists()

@@ -19,6 +19,8 @@ from avatar.cli.assignments import parse_assignments, parse_measurements
 from avatar.clothes import bake, library
 from avatar.errors import AvatarError
 from avatar.human import Human, Recipe
+from avatar.looks import skin_library
+from avatar.looks.skin import IRIS_SRGB
 from avatar.motion.procedural import MOTIONS
 from avatar.rig.skeleton import Animation
 
@@ -53,6 +55,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="also look for poses in this folder; repeatable")  # fmt: skip
     p.add_argument("--wear", action="append", default=[], metavar="NAME|PATH",
                    help="garment from the library or a .mhclo file; repeatable")  # fmt: skip
+    p.add_argument("--eyes", choices=sorted(IRIS_SRGB), help="iris colour (default: brown)")
+    p.add_argument("--skin", metavar="NAME|FILE",
+                   help="a textured MakeHuman/MPFB skin: a .mhmat, or its name in the asset "
+                   "folders (--folder, $AVATAR_CLOTHES_PATH); 'avatar': Avatar's own, by "
+                   "ethnicity, age and gender (the default)")  # fmt: skip
     p.add_argument("--motion", metavar="CLIP.bvh",
                    help="BVH clip to retarget onto the human, or: walk")  # fmt: skip
     motion.add_motion_arguments(p)
@@ -140,9 +147,22 @@ def _recipe(args: argparse.Namespace, model: BodyModel) -> Recipe:
     clothes = tuple(dict.fromkeys(recipe.clothes + tuple(args.wear)))
     hide = recipe.hide_covered if _hiding(args) is None else _hiding(args)
     folders = tuple(dict.fromkeys(recipe.folders + tuple(args.folder)))
+    recipe = replace(recipe, **_looks(args, folders))
     return replace(recipe, params=params, rig=args.rig or recipe.rig, clothes=clothes,
                    pose=args.pose or recipe.pose, hide_covered=hide,
                    folders=folders)  # fmt: skip
+
+
+def _looks(args: argparse.Namespace, folders: tuple[str, ...]) -> dict:
+    """--eyes and --skin as recipe fields (only those given)."""
+    looks: dict = {}
+    if args.eyes:
+        looks["eye_material"] = f"eyes/materials/{args.eyes}.mhmat"
+    if args.skin:
+        wanted = args.skin.strip()
+        looks["skin_material"] = (None if wanted.lower() == "avatar" else
+                                  skin_library.find_skin(wanted, library.user_folders(folders)))
+    return looks
 
 
 def _hiding(args: argparse.Namespace) -> bool | None:

@@ -19,7 +19,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from avatar.errors import AvatarError
+from avatar.errors import AvatarError, ParameterError, unknown_name
 from avatar.io import mhmat
 
 log = logging.getLogger(__name__)
@@ -72,3 +72,25 @@ def _entry(path: Path) -> SkinEntry | None:
     thumbnail = next((str(t) for t in (path.with_suffix(".thumb"), path.with_suffix(".png"))
                       if t.is_file()), None)  # fmt: skip
     return SkinEntry(material.name or path.stem, str(path), thumbnail)
+
+
+def find_skin(name_or_path: str, folders: Iterable[str | os.PathLike[str]]) -> str:
+    """The ``.mhmat`` of a skin named by path or by name (a ``list_skins`` entry's name or
+    file stem). Raises ParameterError (close matches named) for an unknown name, and
+    AvatarError for a file that is missing or has no diffuse texture."""
+    path = Path(name_or_path).expanduser()
+    if path.suffix.lower() == ".mhmat" or path.is_file():
+        if not path.is_file():
+            raise ParameterError(f"{name_or_path}: no such skin material file")
+        material = mhmat.read(path)
+        if "diffuseTexture" not in mhmat.texture_paths(material, path.parent, path):
+            raise ParameterError(f"{name_or_path}: the skin has no diffuse texture")
+        return str(path)
+    skins = list_skins(folders)
+    for skin in skins:
+        if name_or_path in (skin.name, Path(skin.path).stem):
+            return skin.path
+    if not skins:
+        raise ParameterError(f"unknown skin {name_or_path!r}: no textured skins in the asset "
+                             "folders (--folder, $AVATAR_CLOTHES_PATH); give a .mhmat path")
+    raise unknown_name("skin", name_or_path, [s.name for s in skins])
