@@ -77,11 +77,17 @@ def _draw_skin_and_eyes(layout, root, props):
     grid = box.grid_flow(row_major=True, columns=0, even_columns=True, align=True)
     for name, path, thumbnail in (("Avatar", "", ""), *skins):
         cell = grid.column(align=True)
-        icon = thumbnails.skin_icon(path, thumbnail) if thumbnail else 0
+        icon = thumbnails.skin_icon(path, thumbnail) if thumbnail else _builtin_icon("USER")
         if icon:
             cell.template_icon(icon_value=icon, scale=2.5)
         op = cell.operator("avatar.set_skin", text=name, depress=path == current)
         op.path = path
+
+
+def _builtin_icon(name: str) -> int:
+    """A Blender icon's id, for ``template_icon`` (a cell without a picture lines up)."""
+    icons = bpy.types.UILayout.bl_rna.functions["prop"].parameters["icon"].enum_items
+    return icons[name].value if name in icons else 0
 
 
 def _draw_measurements(layout, props, settings):
