@@ -678,7 +678,7 @@ LONG_INNER_V = 0.1  # ... and this much further towards the tips on the innermos
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
                 surface: np.ndarray | None = None, taper=0.7,
                 tip_v: float = 0.0, strip: float = 0.12, u0=None,
-                root_v=0.5) -> Piece:  # fmt: skip
+                root_v=0.5, clear=None) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
     (or to ``surface``, (S, 4) base-mesh faces of it), ``width`` m wide (a float or one per
     card, (N,)), narrowing to ``taper`` (a float or (N,)) of their width at the tips,
@@ -686,7 +686,8 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     thinned-out strand tips; more: cut ends, as a blunt haircut has) and across a random
     ``strip`` of its width (how many of its hairs a card shows); ``u0`` (N,) the strips'
     left edges (None: random); ``root_v`` (a float or (N,)) where the texture starts at
-    the root (0.5: the strands' dark roots; less: lighter, further along the strands)."""
+    the root (0.5: the strands' dark roots; less: lighter, further along the strands);
+    ``clear`` (N, K) m the cards' edges are kept off the skin (None: where they fall)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
@@ -695,6 +696,9 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     half = (width / 2) * rng.uniform(0.7, 1.2, count)[:, None, None]
     half = half * (1 + (taper - 1) * np.linspace(0, 1, k)[None, :, None])
     verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2K, 3)
+    if clear is not None:
+        gap = np.concatenate([clear, clear], 1).reshape(-1)
+        verts = _off_skin(body, verts.reshape(-1, 3), gap).reshape(verts.shape)
     j = np.arange(k - 1)
     quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
     faces = (quad[None] + (2 * k * np.arange(count))[:, None, None]).reshape(-1, 4)
@@ -826,7 +830,7 @@ def hang_cards(
         direction = along * (1 - fall)[..., None] + np.array([0, 0, -1.0]) * fall
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
         gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
-        point = _off_skin(body, point + step * direction, gap)
+        point = _hug_the_sides(body, point + step * direction, gap, centre, eye_z)
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
     path = _fall_clear(_no_lone_locks(path, centre, eye_z + 0.03), centre, eye_z + 0.03)
@@ -840,7 +844,75 @@ def hang_cards(
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
-    return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
+    clear = BOB_EDGE_GAP_M * (_side_weight(path.reshape(-1, 3), centre, eye_z) > 0)
+    return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25,
+                       clear=clear.reshape(path.shape[:2]))
+
+
+BOB_SIDE_GAP_M = 0.008  # a bob's hanging cards over the sides of the head: this far off it
+# ... and their edges at least this far off the skin there: a card drawn in over the ear
+# came within 2 mm of its back by an edge, which lay 2 mm inside a small child's ear.
+BOB_EDGE_GAP_M = 0.005
+
+
+def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
+                   centre: np.ndarray, eye_z: float) -> np.ndarray:  # fmt: skip
+    """(N, 3) hanging cards' points kept ``gap`` (N,) m off the skin, but over the sides of
+    the head, above and over the ears, drawn in towards its vertical axis (through
+    ``centre``) to ``BOB_SIDE_GAP_M`` outside the head's silhouette seen from that axis
+    (``_head_radius``: the ear's rim where they pass over it, so never in between the
+    ear and the skull). Keeping their lift there (up to 2 cm off the skull from the top
+    of the head, falling straight down from it), a bob's sides flared out at ear level,
+    3.5 cm out from the skull and 3 cm from the ears. (Drawn in to 8 mm off the nearest
+    skin instead, a card's point came to lie in the fold behind a woman's ear.)"""
+    w = _side_weight(points, centre, eye_z)
+    target = gap + (np.minimum(gap, BOB_SIDE_GAP_M) - gap) * w
+    rel = points[:, :2] - centre[:2]
+    radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+    limit = _head_radius(body, centre, points) + BOB_SIDE_GAP_M
+    inward = np.maximum(radius - limit, 0) * w
+    out = points.astype(np.float64).copy()
+    out[:, :2] = centre[:2] + rel * ((radius - inward) / radius)[:, None]
+    return _off_skin(body, out, target)
+
+
+def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
+                 step_deg: float = 3.0, step_z: float = 0.004,
+                 reach_deg: float = 12.0) -> np.ndarray:  # fmt: skip
+    """(N,) m from the vertical axis through ``centre`` to the outermost skin of the head
+    (ears included) about the direction and at the height of each point (N, 3): the most
+    of the skin vertices' in a grid of ``step_deg`` by ``step_z`` cells round the axis,
+    widened by ``reach_deg`` round it (a card's half width: a card drawn in by its middle
+    in front of an ear cut through the ear by its edge) and a cell up and down, read
+    bilinearly."""
+    from scipy.ndimage import map_coordinates, maximum_filter
+
+    skin = body.vertices[:BODY_VERTICES]
+    skin = skin[skin[:, 2] > centre[2] - 0.2]
+    rel = skin - centre
+    grid_a = ((np.degrees(np.arctan2(rel[:, 0], -rel[:, 1])) + 180) / step_deg).astype(int)
+    grid_z = ((rel[:, 2] + 0.2) / step_z).astype(int)
+    shape = (int(360 / step_deg) + 1, int(0.45 / step_z) + 1)
+    keep = (grid_z >= 0) & (grid_z < shape[1])
+    table = np.zeros(shape)
+    np.maximum.at(table, (grid_a[keep], grid_z[keep]), np.hypot(rel[keep, 0], rel[keep, 1]))
+    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3), mode="wrap")
+    q = points - centre
+    at = np.stack([(np.degrees(np.arctan2(q[:, 0], -q[:, 1])) + 180) / step_deg - 0.5,
+                   (q[:, 2] + 0.2) / step_z - 0.5])  # fmt: skip
+    return map_coordinates(table, at, order=1, mode="nearest")
+
+
+def _side_weight(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+    """(N,) 0..1 over the sides of the head (65-115 degrees round it, easing out to 35 and
+    145) below 3 cm above the eyes, easing out to 9 cm (the crown keeps its volume). (Eased
+    over 3 cm up and 20 degrees round, cards coming down from the crown's full lift over
+    the temples turned in by 68 degrees, a kink.)"""
+    turn = around(points, centre)
+    round_ = np.clip((turn - 35) / 30, 0, 1) * np.clip((145 - turn) / 30, 0, 1)
+    low = np.clip((eye_z + 0.09 - points[:, 2]) / 0.06, 0, 1)
+    w = round_ * low
+    return w * w * (3 - 2 * w)
 
 
 def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarray:
