@@ -671,6 +671,47 @@ def long_cards(
     return _card_piece(body, path, facing, width, rng, root_v=root_v)
 
 
+SIDE_LOCKS_DEG = (55, 150)  # long hair's side locks root this far round the head ...
+SIDE_LOCKS_Z = (0.0, 0.05)  # ... at these heights above the eyes (under the grown hair)
+SIDE_LOCKS_END = (-0.16, -0.12)  # ... and end here (m from the eyes): on the shoulders
+
+
+def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024,
+               layers=(0.004, 0.016), segments: int = 10, seed: int = 5) -> Piece:  # fmt: skip
+    """Long hair over the sides of the head: locks rooted above and around the ears
+    (``SIDE_LOCKS_*``), combed along ``flow`` and falling over and behind the ears, then
+    straight down at the ears' width (``_fall_clear``) to the shoulders, each at its own
+    height ``layers`` (m) off the skin. MakeHuman's hair ribbons all fall down the back
+    (or over the chest): grown from them alone, long hair narrowed under the ears, short
+    hair over the ears above long locks down the back (a mullet), and the scalp showed
+    between the two from the side. Textured as ``long_cards``' (lighter than the roots)."""
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
+    turn = around(body.vertices[body.skin_faces].mean(axis=1), centre)
+    height = body.vertices[body.skin_faces].mean(axis=1)[:, 2] - eye_z
+    keep = (hairline_mask(body, 0.004) & (turn > SIDE_LOCKS_DEG[0]) & (turn < SIDE_LOCKS_DEG[1])
+            & (height > SIDE_LOCKS_Z[0]) & (height < SIDE_LOCKS_Z[1]))  # fmt: skip
+    roots = _scatter(body, keep, count, rng)
+    lift = rng.uniform(layers[0], layers[1], count)
+    stop = eye_z + rng.uniform(SIDE_LOCKS_END[0], SIDE_LOCKS_END[1], count)
+    step = 0.3 / segments
+    rows, point = [roots], roots
+    for k in range(1, segments + 1):
+        along = _tangent(body, point, flow(point, centre, eye_z))
+        fall = np.clip(k / segments * 4, 0, 1)  # combed a little way, then hanging
+        direction = along * (1 - fall) + np.array([0, 0, -1.0]) * fall
+        direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
+        gap = 0.002 + (lift - 0.002) * min(1.0, k / 3)
+        point = _off_skin(body, point + step * direction, gap)
+        point = _clear_of_the_ears(body, point, gap, centre, eye_z + 0.03)
+        rows.append(point)
+    path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)
+    path = _cut_at(_finer(path, 3), stop)[:, ::3]
+    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    inner = 1 - (lift - layers[0]) / (layers[1] - layers[0])
+    return _card_piece(body, path, normal, width, rng, root_v=LONG_ROOT_V - LONG_INNER_V * inner)
+
+
 LONG_ROOT_V = 0.4  # long cards' texture starts here at the roots (0.5: the darkest roots)
 LONG_INNER_V = 0.1  # ... and this much further towards the tips on the innermost layer
 
@@ -874,6 +915,21 @@ def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
     out = points.astype(np.float64).copy()
     out[:, :2] = centre[:2] + rel * ((radius - inward) / radius)[:, None]
     return _off_skin(body, out, target)
+
+
+def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
+                       centre: np.ndarray, below: float) -> np.ndarray:  # fmt: skip
+    """(N, 3) points below the height ``below`` moved out from the head's vertical axis
+    (through ``centre``) to at least ``gap`` (N,) m outside the head's silhouette seen
+    from it (``_head_radius``, the ears' rims included): kept off the nearest skin only,
+    a long lock's point lay in the fold behind the ear, 1 cm off the skull, which was 8 mm
+    inside a small child's ear."""
+    rel = points[:, :2] - centre[:2]
+    radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+    need = np.where(points[:, 2] < below, _head_radius(body, centre, points) + gap, 0.0)
+    out = points.copy()
+    out[:, :2] = centre[:2] + rel * (np.maximum(radius, need) / radius)[:, None]
+    return out
 
 
 def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
