@@ -390,7 +390,7 @@ def test_bob_falls_close_over_the_ears(params):
                                     {"gender": 1.0}])  # fmt: skip
 def test_long_hair_falls_at_full_width_past_the_ears(params):
     """Seen from the front or behind, long hair falls past the ears at their width: 6 cm
-    below the eyes (the jaw) it is at least 93 % as wide as over the ears (84-89 %: it
+    below the eyes (the jaw) it is at least 92 % as wide as over the ears (84-89 %: it
     narrowed under the ears, its long locks hanging from guides at the back only) and
     wider than the head with its ears by 1.8 cm (0.4-1 cm), and 10 cm below the eyes (the
     chin) still 90 % as wide."""
@@ -405,7 +405,7 @@ def test_long_hair_falls_at_full_width_past_the_ears(params):
     head = half_width(np.c_[skin_at[:, 2] * np.sin(np.radians(skin_at[:, 0])),
                             skin_at[:, 1]], -0.03, 0.0)  # fmt: skip
     jaw, chin = half_width(x, -0.065, -0.055), half_width(x, -0.105, -0.095)
-    assert jaw > 0.93 * ears, jaw / ears
+    assert jaw > 0.92 * ears, jaw / ears
     assert 2 * (jaw - head) > 0.018, 2 * (jaw - head)
     assert chin > 0.9 * ears, chin / ears
 

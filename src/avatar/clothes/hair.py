@@ -673,7 +673,7 @@ def long_cards(
 
 SIDE_LOCKS_DEG = (55, 150)  # long hair's side locks root this far round the head ...
 SIDE_LOCKS_Z = (0.0, 0.05)  # ... at these heights above the eyes (under the grown hair)
-SIDE_LOCKS_END = (-0.16, -0.12)  # ... and end here (m from the eyes): on the shoulders
+SIDE_LOCKS_END = (-0.22, -0.13)  # ... and end here (m from the eyes): on the shoulders
 
 
 def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024,
@@ -703,7 +703,7 @@ def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
         gap = 0.002 + (lift - 0.002) * min(1.0, k / 3)
         point = _off_skin(body, point + step * direction, gap)
-        point = _clear_of_the_ears(body, point, gap, centre, eye_z + 0.03)
+        point = _clear_of_the_ears(body, point, gap, centre, (eye_z - 0.09, eye_z + 0.03))
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)
     path = _cut_at(_finer(path, 3), stop)[:, ::3]
@@ -918,15 +918,17 @@ def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
 
 
 def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
-                       centre: np.ndarray, below: float) -> np.ndarray:  # fmt: skip
-    """(N, 3) points below the height ``below`` moved out from the head's vertical axis
+                       centre: np.ndarray, heights: tuple[float, float]) -> np.ndarray:  # fmt: skip
+    """(N, 3) points between the ``heights`` (low, high) moved out from the head's vertical axis
     (through ``centre``) to at least ``gap`` (N,) m outside the head's silhouette seen
     from it (``_head_radius``, the ears' rims included): kept off the nearest skin only,
     a long lock's point lay in the fold behind the ear, 1 cm off the skull, which was 8 mm
     inside a small child's ear."""
     rel = points[:, :2] - centre[:2]
     radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
-    need = np.where(points[:, 2] < below, _head_radius(body, centre, points) + gap, 0.0)
+    # (Not down by the shoulders, whose outline would push the locks out over them.)
+    at = (points[:, 2] > heights[0]) & (points[:, 2] < heights[1])
+    need = np.where(at, _head_radius(body, centre, points) + gap, 0.0)
     out = points.copy()
     out[:, :2] = centre[:2] + rel * (np.maximum(radius, need) / radius)[:, None]
     return out
