@@ -361,7 +361,7 @@ def test_bob_falls_close_over_the_ears(params):
     """Over the ears (60-120 degrees round the head, from 3 cm below the eyes to 3 cm
     above them) a bob's outer surface lies within 1.8 cm of the head's silhouette seen
     from its vertical axis (the ear's rim where it passes over it), on a man, a woman and
-    two small children: its sides flared out there, 2.4-3.3 cm out (the 95th percentile)
+    two small children: its sides flared out there, 2.5-3.3 cm out (the 95th percentile)
     on all four. And not a vertex inside the ears or the head."""
     from scipy.spatial import cKDTree
 
@@ -375,7 +375,7 @@ def test_bob_falls_close_over_the_ears(params):
     silhouette = np.array([skin_at[n, 2].max() for n in near])
     standoff = hair_at[side, 2] - silhouette
     assert side.sum() > 1000
-    assert np.percentile(standoff, 95) < 0.018, np.percentile(standoff, 95)  # was 0.024-0.033
+    assert np.percentile(standoff, 95) < 0.018, np.percentile(standoff, 95)  # was 0.025-0.033
 
     from avatar.geometry import collision
     from avatar.human import Human

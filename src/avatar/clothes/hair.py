@@ -851,6 +851,7 @@ def hang_cards(
     ends at a random height in that range, and its texture is cut there, not thinned
     out). Roots facing the face (within 50 degrees of the
     front) make a ``fringe`` ending that far above the eyes (None: parted off the face).
+    Over the sides of the head they fall close over the ears (``_hug_the_sides``).
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
