@@ -671,6 +671,47 @@ def long_cards(
     return _card_piece(body, path, facing, width, rng, root_v=root_v)
 
 
+SIDE_LOCKS_DEG = (55, 150)  # long hair's side locks root this far round the head ...
+SIDE_LOCKS_Z = (0.0, 0.05)  # ... at these heights above the eyes (under the grown hair)
+SIDE_LOCKS_END = (-0.22, -0.13)  # ... and end here (m from the eyes): on the shoulders
+
+
+def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024,
+               layers=(0.004, 0.016), segments: int = 10, seed: int = 5) -> Piece:  # fmt: skip
+    """Long hair over the sides of the head: locks rooted above and around the ears
+    (``SIDE_LOCKS_*``), combed along ``flow`` and falling over and behind the ears, then
+    straight down at the ears' width (``_fall_clear``) to the shoulders, each at its own
+    height ``layers`` (m) off the skin. MakeHuman's hair ribbons all fall down the back
+    (or over the chest): grown from them alone, long hair narrowed under the ears, short
+    hair over the ears above long locks down the back (a mullet), and the scalp showed
+    between the two from the side. Textured as ``long_cards``' (lighter than the roots)."""
+    rng = np.random.default_rng([seed, count])
+    centre, eye_z = head_frame(body)
+    turn = around(body.vertices[body.skin_faces].mean(axis=1), centre)
+    height = body.vertices[body.skin_faces].mean(axis=1)[:, 2] - eye_z
+    keep = (hairline_mask(body, 0.004) & (turn > SIDE_LOCKS_DEG[0]) & (turn < SIDE_LOCKS_DEG[1])
+            & (height > SIDE_LOCKS_Z[0]) & (height < SIDE_LOCKS_Z[1]))  # fmt: skip
+    roots = _scatter(body, keep, count, rng)
+    lift = rng.uniform(layers[0], layers[1], count)
+    stop = eye_z + rng.uniform(SIDE_LOCKS_END[0], SIDE_LOCKS_END[1], count)
+    step = 0.3 / segments
+    rows, point = [roots], roots
+    for k in range(1, segments + 1):
+        along = _tangent(body, point, flow(point, centre, eye_z))
+        fall = np.clip(k / segments * 4, 0, 1)  # combed a little way, then hanging
+        direction = along * (1 - fall) + np.array([0, 0, -1.0]) * fall
+        direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
+        gap = 0.002 + (lift - 0.002) * min(1.0, k / 3)
+        point = _off_skin(body, point + step * direction, gap)
+        point = _clear_of_the_ears(body, point, gap, centre, (eye_z - 0.09, eye_z + 0.03))
+        rows.append(point)
+    path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)
+    path = _cut_at(_finer(path, 3), stop)[:, ::3]
+    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    inner = 1 - (lift - layers[0]) / (layers[1] - layers[0])
+    return _card_piece(body, path, normal, width, rng, root_v=LONG_ROOT_V - LONG_INNER_V * inner)
+
+
 LONG_ROOT_V = 0.4  # long cards' texture starts here at the roots (0.5: the darkest roots)
 LONG_INNER_V = 0.1  # ... and this much further towards the tips on the innermost layer
 
@@ -678,7 +719,7 @@ LONG_INNER_V = 0.1  # ... and this much further towards the tips on the innermos
 def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width, rng,
                 surface: np.ndarray | None = None, taper=0.7,
                 tip_v: float = 0.0, strip: float = 0.12, u0=None,
-                root_v=0.5) -> Piece:  # fmt: skip
+                root_v=0.5, clear=None) -> Piece:  # fmt: skip
     """Cards along paths (N, K, 3) lying across the normals (N, K, 3), bound to the skin
     (or to ``surface``, (S, 4) base-mesh faces of it), ``width`` m wide (a float or one per
     card, (N,)), narrowing to ``taper`` (a float or (N,)) of their width at the tips,
@@ -686,7 +727,8 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     thinned-out strand tips; more: cut ends, as a blunt haircut has) and across a random
     ``strip`` of its width (how many of its hairs a card shows); ``u0`` (N,) the strips'
     left edges (None: random); ``root_v`` (a float or (N,)) where the texture starts at
-    the root (0.5: the strands' dark roots; less: lighter, further along the strands)."""
+    the root (0.5: the strands' dark roots; less: lighter, further along the strands);
+    ``clear`` (N, K) m the cards' edges are kept off the skin (None: where they fall)."""
     count, k = path.shape[:2]
     side = np.cross(normal, np.gradient(path, axis=1))
     side /= np.maximum(np.linalg.norm(side, axis=-1, keepdims=True), 1e-9)
@@ -695,6 +737,9 @@ def _card_piece(body: AuthoringBody, path: np.ndarray, normal: np.ndarray, width
     half = (width / 2) * rng.uniform(0.7, 1.2, count)[:, None, None]
     half = half * (1 + (taper - 1) * np.linspace(0, 1, k)[None, :, None])
     verts = np.concatenate([path - half * side, path + half * side], 1)  # (N, 2K, 3)
+    if clear is not None:
+        gap = np.concatenate([clear, clear], 1).reshape(-1)
+        verts = _off_skin(body, verts.reshape(-1, 3), gap).reshape(verts.shape)
     j = np.arange(k - 1)
     quad = np.stack([j, j + 1, k + j + 1, k + j], 1)
     faces = (quad[None] + (2 * k * np.arange(count))[:, None, None]).reshape(-1, 4)
@@ -806,6 +851,7 @@ def hang_cards(
     ends at a random height in that range, and its texture is cut there, not thinned
     out). Roots facing the face (within 50 degrees of the
     front) make a ``fringe`` ending that far above the eyes (None: parted off the face).
+    Over the sides of the head they fall close over the ears (``_hug_the_sides``).
     """
     rng = np.random.default_rng([seed, count])
     centre, eye_z = head_frame(body)
@@ -826,7 +872,7 @@ def hang_cards(
         direction = along * (1 - fall)[..., None] + np.array([0, 0, -1.0]) * fall
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
         gap = 0.002 + (height - 0.002) * min(1.0, (k / 3) ** 0.7)
-        point = _off_skin(body, point + step * direction, gap)
+        point = _hug_the_sides(body, point + step * direction, gap, centre, eye_z)
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)  # (N, K+1, 3)
     path = _fall_clear(_no_lone_locks(path, centre, eye_z + 0.03), centre, eye_z + 0.03)
@@ -840,7 +886,92 @@ def hang_cards(
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
-    return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25)
+    clear = BOB_EDGE_GAP_M * (_side_weight(path.reshape(-1, 3), centre, eye_z) > 0)
+    return _card_piece(body, path, normal, width, rng, taper=0.75, tip_v=0.25,
+                       clear=clear.reshape(path.shape[:2]))
+
+
+BOB_SIDE_GAP_M = 0.008  # a bob's hanging cards over the sides of the head: this far off it
+# ... and their edges at least this far off the skin there: a card drawn in over the ear
+# came within 2 mm of its back by an edge, which lay 2 mm inside a small child's ear.
+BOB_EDGE_GAP_M = 0.005
+
+
+def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
+                   centre: np.ndarray, eye_z: float) -> np.ndarray:  # fmt: skip
+    """(N, 3) hanging cards' points kept ``gap`` (N,) m off the skin, but over the sides of
+    the head, above and over the ears, drawn in towards its vertical axis (through
+    ``centre``) to ``BOB_SIDE_GAP_M`` outside the head's silhouette seen from that axis
+    (``_head_radius``: the ear's rim where they pass over it, so never in between the
+    ear and the skull). Keeping their lift there (up to 2 cm off the skull from the top
+    of the head, falling straight down from it), a bob's sides flared out at ear level,
+    3.5 cm out from the skull and 3 cm from the ears. (Drawn in to 8 mm off the nearest
+    skin instead, a card's point came to lie in the fold behind a woman's ear.)"""
+    w = _side_weight(points, centre, eye_z)
+    target = gap + (np.minimum(gap, BOB_SIDE_GAP_M) - gap) * w
+    rel = points[:, :2] - centre[:2]
+    radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+    limit = _head_radius(body, centre, points) + BOB_SIDE_GAP_M
+    inward = np.maximum(radius - limit, 0) * w
+    out = points.astype(np.float64).copy()
+    out[:, :2] = centre[:2] + rel * ((radius - inward) / radius)[:, None]
+    return _off_skin(body, out, target)
+
+
+def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
+                       centre: np.ndarray, heights: tuple[float, float]) -> np.ndarray:  # fmt: skip
+    """(N, 3) points between the ``heights`` (low, high) moved out from the head's vertical axis
+    (through ``centre``) to at least ``gap`` (N,) m outside the head's silhouette seen
+    from it (``_head_radius``, the ears' rims included): kept off the nearest skin only,
+    a long lock's point lay in the fold behind the ear, 1 cm off the skull, which was 8 mm
+    inside a small child's ear."""
+    rel = points[:, :2] - centre[:2]
+    radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
+    # (Not down by the shoulders, whose outline would push the locks out over them.)
+    at = (points[:, 2] > heights[0]) & (points[:, 2] < heights[1])
+    need = np.where(at, _head_radius(body, centre, points) + gap, 0.0)
+    out = points.copy()
+    out[:, :2] = centre[:2] + rel * (np.maximum(radius, need) / radius)[:, None]
+    return out
+
+
+def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
+                 step_deg: float = 3.0, step_z: float = 0.004,
+                 reach_deg: float = 12.0) -> np.ndarray:  # fmt: skip
+    """(N,) m from the vertical axis through ``centre`` to the outermost skin of the head
+    (ears included) about the direction and at the height of each point (N, 3): the most
+    of the skin vertices' in a grid of ``step_deg`` by ``step_z`` cells round the axis,
+    widened by ``reach_deg`` round it (a card's half width: a card drawn in by its middle
+    in front of an ear cut through the ear by its edge) and a cell up and down, read
+    bilinearly."""
+    from scipy.ndimage import map_coordinates, maximum_filter
+
+    skin = body.vertices[:BODY_VERTICES]
+    skin = skin[skin[:, 2] > centre[2] - 0.2]
+    rel = skin - centre
+    grid_a = ((np.degrees(np.arctan2(rel[:, 0], -rel[:, 1])) + 180) / step_deg).astype(int)
+    grid_z = ((rel[:, 2] + 0.2) / step_z).astype(int)
+    shape = (int(360 / step_deg) + 1, int(0.45 / step_z) + 1)
+    keep = (grid_z >= 0) & (grid_z < shape[1])
+    table = np.zeros(shape)
+    np.maximum.at(table, (grid_a[keep], grid_z[keep]), np.hypot(rel[keep, 0], rel[keep, 1]))
+    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3), mode="wrap")
+    q = points - centre
+    at = np.stack([(np.degrees(np.arctan2(q[:, 0], -q[:, 1])) + 180) / step_deg - 0.5,
+                   (q[:, 2] + 0.2) / step_z - 0.5])  # fmt: skip
+    return map_coordinates(table, at, order=1, mode="nearest")
+
+
+def _side_weight(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
+    """(N,) 0..1 over the sides of the head (65-115 degrees round it, easing out to 35 and
+    145) below 3 cm above the eyes, easing out to 9 cm (the crown keeps its volume). (Eased
+    over 3 cm up and 20 degrees round, cards coming down from the crown's full lift over
+    the temples turned in by 68 degrees, a kink.)"""
+    turn = around(points, centre)
+    round_ = np.clip((turn - 35) / 30, 0, 1) * np.clip((145 - turn) / 30, 0, 1)
+    low = np.clip((eye_z + 0.09 - points[:, 2]) / 0.06, 0, 1)
+    w = round_ * low
+    return w * w * (3 - 2 * w)
 
 
 def _fall_clear(path: np.ndarray, centre: np.ndarray, below: float) -> np.ndarray:
