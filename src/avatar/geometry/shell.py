@@ -84,3 +84,28 @@ def extrude(inner: np.ndarray, normals: np.ndarray, thickness: float) -> np.ndar
     """(..., 2N, 3) shell vertices: inner (..., N, 3) then inner + thickness * normals."""
     outer = inner + np.float32(thickness) * normals
     return np.concatenate([inner, outer], axis=-2).astype(np.float32)
+
+
+EDGE_ON = 0.2  # cosine between the cloth's and the side's normals below which cloth is edge-on
+
+
+def cloth_normals(points: np.ndarray, faces: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """(N, 3) float32 unit normals of a surface's cloth (``points`` (N, 3), quads or padded
+    triangles ``faces``), each face counted once a corner, on the side of ``side`` (N, 3)
+    (e.g. the skin's normal); ``side``'s direction where the cloth is edge-on to it or has
+    no normal. What a posed frame grows a shell's outer layer along (``Outfit``)."""
+    p = np.asarray(points, np.float64)
+    c = p[faces]
+    across = np.cross(c[:, 2] - c[:, 0], c[:, -1] - c[:, 1])
+    normal = np.zeros_like(p)
+    for k in range(faces.shape[1]):
+        fresh = ~(faces[:, :k] == faces[:, k : k + 1]).any(axis=1)  # a repeated corner once
+        np.add.at(normal, faces[fresh, k], across[fresh])
+    side = np.asarray(side, np.float64)
+    size = np.maximum(np.linalg.norm(normal, axis=1), 1e-12)
+    length = np.maximum(np.linalg.norm(side, axis=1), 1e-12)
+    cos = np.einsum("nd,nd->n", normal, side) / (size * length)
+    unit = normal * (np.sign(cos) / size)[:, None]
+    return np.where((np.abs(cos) > EDGE_ON)[:, None], unit, side / length[:, None]).astype(
+        np.float32
+    )
