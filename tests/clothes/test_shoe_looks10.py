@@ -157,11 +157,13 @@ WEARERS = {"man": {"gender": 1.0, "age": 0.5}, "woman": {"gender": 0.0},
 def test_toe_caps_outer_surface_turns_no_more_than_its_inner(who):
     """Fitted, a toe cap's outer surface (the leather seen) turns between neighbouring faces
     hardly more than its inner one: within 3 degrees of it for all but one edge in twenty,
-    and never over 100. Grown along the skin's normal, which turns from toe to toe, the
+    and never over 60. Grown along the skin's normal, which turns from toe to toe, the
     outer surface rippled over the toes (one edge in twenty: 27.5 against the inner's 21.3
     on a man, 25.6 against 18.1 on a child; up to 97, 127 and 150 degrees on a man, a woman
-    and a child): blotchy highlights on the leather."""
+    and a child): blotchy highlights on the leather. Grown along the shoe's normals but the
+    skin's where the shoe is edge-on to it, the nose's top still turned 90 degrees on a man's
+    (75 on a child's)."""
     inner, outer = _cap_turns(WEARERS[who])
     assert np.percentile(outer, 95) < np.percentile(inner, 95) + 3, (
         np.percentile(outer, 95), np.percentile(inner, 95))
-    assert outer.max() < 100, outer.max()
+    assert outer.max() < 60, outer.max()

@@ -23,7 +23,7 @@ from avatar.clothes.binding import Binding, axis_scale, fit
 from avatar.clothes.contacts import remote_contacts
 from avatar.clothes.outfit import Outfit
 from avatar.geometry import collision
-from avatar.geometry.shell import EDGE_ON, Shell, cloth_normals, extrude, solidify
+from avatar.geometry.shell import Shell, cloth_normals, extrude, solidify
 from avatar.io.mhw import BoneWeights
 from avatar.material import Material
 from avatar.mesh import Mesh, face_normals, vertex_normals
@@ -281,19 +281,20 @@ def _with_shell(garment: Garment, inner: np.ndarray, q, w: SkinWeights):
 
 def shell_directions(garment: Garment, inner: np.ndarray, skin_normal: np.ndarray) -> np.ndarray:
     """(N, 3) the directions a shell's outer layer grows along at rest: the skin's normal,
-    except footwear's, along the shoe's own normals (as frames grow it: ``Outfit``), out on
-    the side its faces face (``shoes._facing_out``); the skin's normal where the shoe is
-    edge-on to the skin. Grown along the skin's normal, which turns from toe to toe, a toe
-    cap's outer surface turned 6 degrees more than its inner one between neighbouring faces
-    (one edge in twenty; up to 150 on a child's) and its highlights showed blotches. Turned
-    to the skin's side instead of the faces' own, the sole's bottom rim grew inwards, folded
-    and was pulled back (a man's sole 0.6 mm off the floor)."""
+    except footwear's, along the shoe's own normals out on the side its faces face
+    (``shoes._facing_out``), as frames grow it (``Outfit``). Grown along the skin's normal,
+    which turns from toe to toe, a toe cap's outer surface turned 6 degrees more than its
+    inner one between neighbouring faces (one edge in twenty; up to 150 on a child's) and
+    its highlights showed blotches. A shoe is no skin-tight cloth: where it stands off the
+    foot (the toe box past the toes, the sole's rim) the skin's normal says nothing of its
+    outside. Turned to the skin's side, the sole's bottom rim grew inwards and was pulled
+    back (a man's sole 0.6 mm off the floor); grown along the skin's normal where the shoe
+    is edge-on to it, the nose's top grew forwards between points growing up (90 degrees
+    between neighbouring faces on a man's)."""
     if garment.category != "footwear":
         return skin_normal
     faces = garment.mesh.faces
-    cloth = cloth_normals(inner, faces, vertex_normals(inner, faces))
-    edge_on = np.abs(np.einsum("nd,nd->n", cloth, skin_normal)) <= EDGE_ON
-    return np.where(edge_on[:, None], skin_normal, cloth)
+    return cloth_normals(inner, faces, vertex_normals(inner, faces))
 
 
 def fit_garment(
