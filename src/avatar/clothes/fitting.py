@@ -23,10 +23,10 @@ from avatar.clothes.binding import Binding, axis_scale, fit
 from avatar.clothes.contacts import remote_contacts
 from avatar.clothes.outfit import Outfit
 from avatar.geometry import collision
-from avatar.geometry.shell import Shell, cloth_normals, extrude, solidify
+from avatar.geometry.shell import Shell, corner_gather, extrude, solidify, summed_normals
 from avatar.io.mhw import BoneWeights
 from avatar.material import Material
-from avatar.mesh import Mesh, face_normals, vertex_normals
+from avatar.mesh import Mesh, face_normals
 from avatar.rig.skinning import SkinWeights
 
 CLEARANCE = 0.002  # m between skin and a garment's inside
@@ -91,6 +91,18 @@ class Garment:
         n = len(self.mesh.vertices)
         return (*face_pairs(self.mesh.faces),
                 _spread_matrix([self.mesh.faces], np.arange(n), 1))  # fmt: skip
+
+    @cached_property
+    def footwear_fairing(self) -> tuple:
+        """((N, F) sparse: the faces at each vertex, ``corner_gather``; (N, 3) the made
+        surface's detail, what ``DETAIL_PASSES`` neighbour averages take away): footwear's
+        ``fitted_surface`` and ``shell_directions``, computed once."""
+        spread = self.untangling[2]
+        made = self.mesh.vertices.astype(np.float64)
+        shape = made
+        for _ in range(DETAIL_PASSES):
+            shape = spread @ shape
+        return corner_gather(self.mesh.faces, len(made)), made - shape
 
     @cached_property
     def shell(self) -> Shell | None:
@@ -293,8 +305,9 @@ def shell_directions(garment: Garment, inner: np.ndarray, skin_normal: np.ndarra
     between neighbouring faces on a man's)."""
     if garment.category != "footwear":
         return skin_normal
-    faces = garment.mesh.faces
-    return cloth_normals(inner, faces, vertex_normals(inner, faces))
+    normal = summed_normals(inner, garment.mesh.faces, garment.footwear_fairing[0])
+    size = np.linalg.norm(normal, axis=1)[:, None]
+    return np.where(size > 1e-12, normal / np.maximum(size, 1e-12), skin_normal).astype(np.float32)
 
 
 DETAIL_PASSES = 2  # neighbour averages that part a shoe's shape on a body from its detail
@@ -312,12 +325,11 @@ def fitted_surface(garment: Garment, body_vertices: np.ndarray) -> np.ndarray:
     if garment.category != "footwear":
         return points
     spread = garment.untangling[2]
-    made = garment.mesh.vertices.astype(np.float64)
-    shape, made_shape = points.astype(np.float64), made
+    shape = points.astype(np.float64)
     for _ in range(DETAIL_PASSES):
-        shape, made_shape = spread @ shape, spread @ made_shape
+        shape = spread @ shape
     scale = axis_scale(garment.binding, np.asarray(body_vertices, np.float64))
-    return (shape + scale * (made - made_shape)).astype(np.float32)
+    return (shape + scale * garment.footwear_fairing[1]).astype(np.float32)
 
 
 def fit_garment(
@@ -410,7 +422,7 @@ def _worn_by(body: Body, garment: Garment) -> Garment:
     if thickness == garment.thickness:
         return garment
     thin = replace(garment, thickness=thickness)
-    for key in ("anchor_cache", "weight_cache", "shell", "untangling"):
+    for key in ("anchor_cache", "weight_cache", "shell", "untangling", "footwear_fairing"):
         thin.__dict__[key] = getattr(garment, key)
     return thin
 

@@ -20,7 +20,6 @@ from avatar.clothes.contacts import REMOTE_K, remote_contacts
 from avatar.clothes.hems import HemSpread
 from avatar.geometry import collision
 from avatar.geometry.nearest import PointTree
-from avatar.geometry.shell import EDGE_ON
 from avatar.rig.skinning import SkinWeights, linear_blend
 
 if TYPE_CHECKING:
@@ -487,6 +486,9 @@ class _ShellCloth:
         unit = normal * (np.sign(cos) / size)[:, None]
         return np.where((np.abs(cos) > EDGE_ON)[:, None], unit,
                         turned / length[:, None]).astype(np.float32)  # fmt: skip
+
+
+EDGE_ON = 0.2  # cosine between the cloth's and the skin's normals below which cloth is edge-on
 
 
 def _outer_at_rest(g: FittedGarment, count: int) -> np.ndarray:

@@ -86,26 +86,19 @@ def extrude(inner: np.ndarray, normals: np.ndarray, thickness: float) -> np.ndar
     return np.concatenate([inner, outer], axis=-2).astype(np.float32)
 
 
-EDGE_ON = 0.2  # cosine between the cloth's and the side's normals below which cloth is edge-on
+def corner_gather(faces: np.ndarray, count: int):
+    """(count, F) sparse float32: 1 where a face meets a vertex (a padded triangle's
+    repeated corner once), to sum faces' values at vertices (``summed_normals``)."""
+    from scipy.sparse import csr_matrix
+
+    pairs = np.unique(np.stack([faces.ravel(), np.repeat(np.arange(len(faces)), faces.shape[1])],
+                               1), axis=0)  # fmt: skip
+    return csr_matrix((np.ones(len(pairs), np.float32), (pairs[:, 0], pairs[:, 1])),
+                      shape=(count, len(faces)))  # fmt: skip
 
 
-def cloth_normals(points: np.ndarray, faces: np.ndarray, side: np.ndarray) -> np.ndarray:
-    """(N, 3) float32 unit normals of a surface's cloth (``points`` (N, 3), quads or padded
-    triangles ``faces``), each face counted once a corner, on the side of ``side`` (N, 3)
-    (e.g. the skin's normal); ``side``'s direction where the cloth is edge-on to it or has
-    no normal. What a posed frame grows a shell's outer layer along (``Outfit``)."""
-    p = np.asarray(points, np.float64)
-    c = p[faces]
-    across = np.cross(c[:, 2] - c[:, 0], c[:, -1] - c[:, 1])
-    normal = np.zeros_like(p)
-    for k in range(faces.shape[1]):
-        fresh = ~(faces[:, :k] == faces[:, k : k + 1]).any(axis=1)  # a repeated corner once
-        np.add.at(normal, faces[fresh, k], across[fresh])
-    side = np.asarray(side, np.float64)
-    size = np.maximum(np.linalg.norm(normal, axis=1), 1e-12)
-    length = np.maximum(np.linalg.norm(side, axis=1), 1e-12)
-    cos = np.einsum("nd,nd->n", normal, side) / (size * length)
-    unit = normal * (np.sign(cos) / size)[:, None]
-    return np.where((np.abs(cos) > EDGE_ON)[:, None], unit, side / length[:, None]).astype(
-        np.float32
-    )
+def summed_normals(points: np.ndarray, faces: np.ndarray, gather) -> np.ndarray:
+    """(N, 3) float64 each vertex's faces' normals (quads or padded triangles ``faces``,
+    the cross product of their diagonals) summed, unnormalised; gather: ``corner_gather``."""
+    c = np.asarray(points, np.float64)[faces]
+    return np.asarray(gather @ np.cross(c[:, 2] - c[:, 0], c[:, -1] - c[:, 1]))
