@@ -23,7 +23,7 @@ from avatar.clothes.binding import Binding, axis_scale, fit
 from avatar.clothes.contacts import remote_contacts
 from avatar.clothes.outfit import Outfit
 from avatar.geometry import collision
-from avatar.geometry.shell import Shell, extrude, solidify
+from avatar.geometry.shell import Shell, corner_gather, extrude, solidify, summed_normals
 from avatar.io.mhw import BoneWeights
 from avatar.material import Material
 from avatar.mesh import Mesh, face_normals
@@ -91,6 +91,18 @@ class Garment:
         n = len(self.mesh.vertices)
         return (*face_pairs(self.mesh.faces),
                 _spread_matrix([self.mesh.faces], np.arange(n), 1))  # fmt: skip
+
+    @cached_property
+    def footwear_fairing(self) -> tuple:
+        """((N, F) sparse: the faces at each vertex, ``corner_gather``; (N, 3) the made
+        surface's detail, what ``DETAIL_PASSES`` neighbour averages take away): footwear's
+        ``fitted_surface`` and ``shell_directions``, computed once."""
+        spread = self.untangling[2]
+        made = self.mesh.vertices.astype(np.float64)
+        shape = made
+        for _ in range(DETAIL_PASSES):
+            shape = spread @ shape
+        return corner_gather(self.mesh.faces, len(made)), made - shape
 
     @cached_property
     def shell(self) -> Shell | None:
@@ -274,16 +286,60 @@ def _with_shell(garment: Garment, inner: np.ndarray, q, w: SkinWeights):
     shell = garment.shell
     if shell is None:
         return garment.mesh.with_vertices(inner), w
-    verts = extrude(inner, q.normal, garment.thickness)
+    verts = extrude(inner, shell_directions(garment, inner, q.normal), garment.thickness)
     both = SkinWeights(np.concatenate([w.indices] * 2), np.concatenate([w.weights] * 2))
     return shell.mesh.with_vertices(verts), both
+
+
+def shell_directions(garment: Garment, inner: np.ndarray, skin_normal: np.ndarray) -> np.ndarray:
+    """(N, 3) the directions a shell's outer layer grows along at rest: the skin's normal,
+    except footwear's, along the shoe's own normals out on the side its faces face
+    (``shoes._facing_out``), as frames grow it (``Outfit``). Grown along the skin's normal,
+    which turns from toe to toe, a toe cap's outer surface turned 6 degrees more than its
+    inner one between neighbouring faces (one edge in twenty; up to 150 on a child's) and
+    its highlights showed blotches. A shoe is no skin-tight cloth: where it stands off the
+    foot (the toe box past the toes, the sole's rim) the skin's normal says nothing of its
+    outside. Turned to the skin's side, the sole's bottom rim grew inwards and was pulled
+    back (a man's sole 0.6 mm off the floor); grown along the skin's normal where the shoe
+    is edge-on to it, the nose's top grew forwards between points growing up (90 degrees
+    between neighbouring faces on a man's)."""
+    if garment.category != "footwear":
+        return skin_normal
+    normal = summed_normals(inner, garment.mesh.faces, garment.footwear_fairing[0])
+    size = np.linalg.norm(normal, axis=1)[:, None]
+    return np.where(size > 1e-12, normal / np.maximum(size, 1e-12), skin_normal).astype(np.float32)
+
+
+# Neighbour averages that part a shoe's shape on a body from its detail: one evens the toe
+# cap's faces (2 evened them a little more, but widened a child's sneaker for its foot by
+# 0.6%, past the adults' range).
+DETAIL_PASSES = 1
+
+
+def fitted_surface(garment: Garment, body_vertices: np.ndarray) -> np.ndarray:
+    """(N, 3) float32 a garment's surface on a body by its binding; footwear's smoothed:
+    its broad shape from the binding, its detail (what ``DETAIL_PASSES`` neighbour
+    averages take away) as made on the authoring body, scaled by the foot. A shoe's faces
+    are each bound to the helper's nearest face, and on other feet neighbouring vertices'
+    nearest faces jump across the helper's edges: the toe cap, faired to turn under 15
+    degrees between neighbouring faces for all but one edge in twenty, turned 21 on a man's
+    foot (up to 61): ripples over the toes."""
+    points = fit(garment.binding, body_vertices)
+    if garment.category != "footwear":
+        return points
+    spread = garment.untangling[2]
+    shape = points.astype(np.float64)
+    for _ in range(DETAIL_PASSES):
+        shape = spread @ shape
+    scale = axis_scale(garment.binding, np.asarray(body_vertices, np.float64))
+    return (shape + scale * garment.footwear_fairing[1]).astype(np.float32)
 
 
 def fit_garment(
     pose: Pose, garment: Garment, body_vertices: np.ndarray
 ) -> tuple[np.ndarray, object]:
     """(N, 3) bound surface of a garment on a body (rest), resolved when it collides."""
-    points = fit(garment.binding, body_vertices)
+    points = fitted_surface(garment, body_vertices)
     if not garment.collide:
         return points, None
     if "inner" in garment.anchor_cache:
@@ -369,7 +425,7 @@ def _worn_by(body: Body, garment: Garment) -> Garment:
     if thickness == garment.thickness:
         return garment
     thin = replace(garment, thickness=thickness)
-    for key in ("anchor_cache", "weight_cache", "shell", "untangling"):
+    for key in ("anchor_cache", "weight_cache", "shell", "untangling", "footwear_fairing"):
         thin.__dict__[key] = getattr(garment, key)
     return thin
 

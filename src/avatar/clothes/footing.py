@@ -3,11 +3,11 @@
 A shaped body stands with its feet on z = 0 (``body.shaped.rest_vertices``). A shoe's sole
 lies under the foot, so a shod body must stand up by the sole's depth, or the sole sinks
 into the floor. ``sole_height`` measures that depth on the body itself: the footwear's
-binding evaluated on it (what ``fitting`` does first) and the shell's outer layer grown
-along the skin normal by its ``worn_thickness``, as ``fitting`` grows it; the lowest of
-those points is how far the floor is below the soles. The composition root (``Human``)
-lifts the body, and so its rig and every garment, by that much, and lifts settled poses
-by it too.
+surface fitted on it (``fitting.fitted_surface``, what ``fitting`` does first) and the
+shell's outer layer grown by its ``worn_thickness`` along the shoe's own normals, as
+``fitting`` grows it; the lowest of those points is how far the floor is below the
+soles. The composition root (``Human``) lifts the body, and so its rig and every garment,
+by that much, and lifts settled poses by it too.
 """
 
 from __future__ import annotations
@@ -19,8 +19,7 @@ import numpy as np
 
 from avatar.body.model import BODY_VERTICES, BodyModel
 from avatar.clothes import builtin
-from avatar.clothes.binding import fit
-from avatar.clothes.fitting import worn_thickness
+from avatar.clothes.fitting import fitted_surface, shell_directions, worn_thickness
 from avatar.geometry import collision
 
 FOOTWEAR = "footwear"
@@ -54,13 +53,22 @@ def sole_height(
     lowest = np.inf
     for name in names:
         garment = library.load_garment(name, folders, model=model)
-        points = fit(garment.binding, vertices)
+        points = fitted_surface(garment, vertices)
         # Only the bottom matters: the points within 2 cm of the lowest.
-        low = points[points[:, 2] < points[:, 2].min() + 0.02]
-        q = collision.query(skin, surface, low, k=4)
-        outer = low + np.float32(worn_thickness(garment, vertices)) * q.normal
-        lowest = min(lowest, float(low[:, 2].min()), float(outer[:, 2].min()))
+        low = np.flatnonzero(points[:, 2] < points[:, 2].min() + 0.02)
+        q = collision.query(skin, surface, points[low], k=4)
+        grown = shell_directions(garment, points, _skin_side(q.normal, low, len(points)))[low]
+        outer = points[low] + np.float32(worn_thickness(garment, vertices)) * grown
+        lowest = min(lowest, float(points[low, 2].min()), float(outer[:, 2].min()))
     return max(0.0, -lowest)
+
+
+def _skin_side(normal: np.ndarray, rows: np.ndarray, count: int) -> np.ndarray:
+    """(count, 3) the skin's normals at ``rows``, straight down elsewhere (only the bottom
+    rows' shell is grown: the others' side is never read)."""
+    side = np.tile(np.array([0, 0, -1], np.float32), (count, 1))
+    side[rows] = normal
+    return side
 
 
 __all__ = ["sole_height", "worn_footwear"]

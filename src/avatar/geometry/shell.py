@@ -84,3 +84,21 @@ def extrude(inner: np.ndarray, normals: np.ndarray, thickness: float) -> np.ndar
     """(..., 2N, 3) shell vertices: inner (..., N, 3) then inner + thickness * normals."""
     outer = inner + np.float32(thickness) * normals
     return np.concatenate([inner, outer], axis=-2).astype(np.float32)
+
+
+def corner_gather(faces: np.ndarray, count: int):
+    """(count, F) sparse float32: 1 where a face meets a vertex (a padded triangle's
+    repeated corner once), to sum faces' values at vertices (``summed_normals``)."""
+    from scipy.sparse import csr_matrix
+
+    pairs = np.unique(np.stack([faces.ravel(), np.repeat(np.arange(len(faces)), faces.shape[1])],
+                               1), axis=0)  # fmt: skip
+    return csr_matrix((np.ones(len(pairs), np.float32), (pairs[:, 0], pairs[:, 1])),
+                      shape=(count, len(faces)))  # fmt: skip
+
+
+def summed_normals(points: np.ndarray, faces: np.ndarray, gather) -> np.ndarray:
+    """(N, 3) float64 each vertex's faces' normals (quads or padded triangles ``faces``,
+    the cross product of their diagonals) summed, unnormalised; gather: ``corner_gather``."""
+    c = np.asarray(points, np.float64)[faces]
+    return np.asarray(gather @ np.cross(c[:, 2] - c[:, 0], c[:, -1] - c[:, 1]))
