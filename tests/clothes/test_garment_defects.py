@@ -85,6 +85,34 @@ def test_jeans_rise_to_the_waist_not_below_it(params):
     assert back >= front - 0.005
 
 
+def _fly_setbacks(human: Human, name: str) -> np.ndarray:
+    """(R,) m the front-most cloth at the midline (within 1.5 cm of it) stands behind the
+    front-most cloth between the hip joints' x, in 1 cm rows from 4 to 8 cm above the
+    crotch point: how deep a V the cloth makes over the groin, seen from the front."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    fitted = human.outfit.garments[0]
+    v = fitted.mesh.vertices[: len(fitted.garment.mesh.vertices)].astype(np.float64)
+    hip = AuthoringBody(human.body).marks.hip
+    front = (v[:, 1] < hip[0, 1]) & (np.abs(v[:, 0]) < abs(hip[0, 0]))
+    middle = front & (np.abs(v[:, 0]) < 0.015)
+    crotch = v[middle, 2].min()
+    rows = [front & (np.abs(v[:, 2] - z) < 0.006) for z in crotch + np.arange(0.04, 0.085, 0.01)]
+    return np.array([v[r & middle, 1].min() - v[r, 1].min() for r in rows if (r & middle).any()])
+
+
+@pytest.mark.parametrize("name", ["sweatpants", "trousers", "shorts", "jeans"])
+@pytest.mark.parametrize("params", [{"gender": 0.0, "age": 0.45}, {"age": 0.15}])
+def test_loose_bottoms_span_the_front_of_the_crotch(name, params):
+    """Cut from the tights shell, loose trousers followed the groin: 4-8 cm above the
+    crotch their front midline stood up to 11 cm (woman's sweatpants), 5-8 cm (child's)
+    behind the cloth over the thighs, a deep V from the front. Spanning from thigh to
+    thigh (``builtin.across_the_fly``) it stands no more than 3 cm behind."""
+    setbacks = _fly_setbacks(Human(params).dressed(name), name)
+    assert len(setbacks) >= 3
+    assert setbacks.max() < 0.03, np.round(setbacks * 1000)
+
+
 def _on_surface(mesh, uv_points: np.ndarray) -> np.ndarray:
     """(N, 3) points of a quad mesh with per-corner UVs under texture points (N, 2) (NaN
     where no face covers one)."""
