@@ -141,11 +141,13 @@ def across_the_fly(body: AuthoringBody, mesh: Mesh) -> Mesh:
     """Loose trousers spanning the front of the crotch from thigh to thigh: each vertex
     on the front between the hip joints brought towards the depth of the cloth's
     front-most vertex about its height (the thighs' crowns), never back. Cut from the
-    tights shell, sweatpants, trousers, shorts and jeans followed the groin: 4-8 cm above
-    the crotch point their front midline stood 5-11 cm behind the cloth over the thighs,
-    a deep V (a camel toe) on women and children. A move forward over the groin only
-    takes the cloth further off the skin; one within a row keeps the vertices' order front
-    to back, so the cloth does not fold through itself."""
+    tights shell, sweatpants, trousers, shorts and jeans followed the groin: seen from the
+    front, 5-8 cm above the crotch point their cloth at the midline stood 44-75 mm behind
+    the cloth over the thighs, a deep V (a camel toe) on women and children. Vertices whose
+    cloth faces back (the crotch's gusset between the legs, the far wall of the seam's
+    curve) stay: laid flat with the rest, the small faces round the front crotch seam
+    folded over (2-8 turned back, specks on the fly). Moving forward over the groin only
+    takes the cloth further off the skin."""
     v = mesh.vertices.astype(np.float64)
     hip = body.marks.hip
     reach = abs(float(hip[0, 0]))  # the thighs' crowns lie within a hip joint's x of the midline
@@ -155,12 +157,25 @@ def across_the_fly(body: AuthoringBody, mesh: Mesh) -> Mesh:
     if len(pick) == 0:
         return mesh
     crowns = np.flatnonzero(front)
-    row = np.abs(v[pick, None, 2] - v[None, crowns, 2]) < 0.015  # (P, C) about level
+    row = np.abs(v[pick, None, 2] - v[None, crowns, 2]) < 0.03  # (P, C) about level
     depth = np.where(row, v[None, crowns, 1], np.inf).min(axis=1)  # front-most y per row
     t = np.clip((v[pick, 2] - crotch) / FLY_RISE, 0, 1)
-    share = FLY_SHARE * t * t * (3 - 2 * t)
+    facing = np.clip((0.2 - _vertex_normals(v, mesh.faces)[pick, 1]) / 0.4, 0, 1)
+    share = FLY_SHARE * t * t * (3 - 2 * t) * facing
     v[pick, 1] -= share * np.clip(v[pick, 1] - depth, 0, None)
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+def _vertex_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(N, 3) unit normals of a quad mesh's vertices, turned to face out of the body (most
+    of a garment's faces face away from its centre)."""
+    normal = np.cross(v[faces[:, 2]] - v[faces[:, 0]], v[faces[:, 3]] - v[faces[:, 1]])
+    if np.einsum("nd,nd->", normal, v[faces].mean(axis=1) - v.mean(axis=0)) < 0:
+        normal = -normal
+    out = np.zeros_like(v)
+    for k in range(faces.shape[1]):
+        np.add.at(out, faces[:, k], normal)
+    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
 
 
 def spread_across(body: AuthoringBody, mesh: Mesh, passes: int = 8) -> Mesh:
