@@ -48,6 +48,8 @@ class Garment:
     collide: False for face proxies (eyebrows, eyelashes) that sit on the skin by design.
     swing_below: m (height on the authored mesh); a skirt's transferred skin weights are
         smoothed over its cloth below it (``weights.swing``). None: as transferred.
+    fly_share: (N,) loose trousers' bridge across the fly: each vertex's transferred
+        weights shared this much with its mirror twin's (``weights.shared_across``).
     delete_verts: (D,) int32 base-mesh vertices the garment covers (hidden if the user asks).
     """
 
@@ -66,6 +68,7 @@ class Garment:
     source: str = "builtin"
     licence: str = ""
     swing_below: float | None = None
+    fly_share: np.ndarray | None = None
 
     @cached_property
     def anchor_cache(self) -> dict:
@@ -251,6 +254,8 @@ def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None
         result = weights.transfer(garment.binding, body_weights)
         if garment.swing_below is not None:
             result = weights.swing(result, garment.mesh, garment.swing_below)
+        if garment.fly_share is not None:
+            result = weights.shared_across(result, garment.mesh, garment.fly_share)
     garment.weight_cache[:] = [(body_weights, names, result)]  # holds body_weights: no id reuse
     return result
 
