@@ -5,6 +5,7 @@ mid-stride, front and back, with ``render_closeups``' row cameras.
     python bench/render_looks10_garments.py woman --views front,back [--walk] --samples 12
     python bench/render_looks10_garments.py heavy ...; python ... child ...
     python bench/render_looks10_garments.py fly --views front --samples 12 --size 300
+    python bench/render_looks10_garments.py flywalk --views front --walk --samples 16 --size 400
 
 Needs the pip ``bpy`` module (Cycles on the CPU).
 """
@@ -41,8 +42,12 @@ SETS["fly"] = [  # loose bottoms across the front of the crotch: woman, child, h
     (BODIES["child"], ("tshirt", "sweatpants")),
     (BODIES["heavy"], ("tshirt", "shorts")),
 ]
-FRAMING = {"fly": (0.5, 1.0, 0.7), "woman": (0.62, 3.0, 0.84), "heavy": (0.75, 2.8, 0.88),
-           "child": (0.5, 2.6, 0.58)}  # fmt: skip
+SETS["flywalk"] = [  # the fly mid-stride, zoomed: the heavy man's shorts and sweatpants
+    (BODIES["heavy"], ("tshirt", "shorts")),
+    (BODIES["heavy"], ("tshirt", "sweatpants")),
+]
+FRAMING = {"fly": (0.5, 1.0, 0.7), "flywalk": (0.34, 1.0, 0.76), "woman": (0.62, 3.0, 0.84),
+           "heavy": (0.75, 2.8, 0.88), "child": (0.5, 2.6, 0.58)}  # fmt: skip
 
 
 def main() -> None:

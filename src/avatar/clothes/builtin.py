@@ -138,6 +138,7 @@ def spanned(body: AuthoringBody, mesh: Mesh) -> Mesh:
 # the groin is laid FLY_SHARE of the way out to the thighs' fronts (reached FLY_RISE m above
 # the crotch point, from nothing there: the crotch seam still runs back between the legs).
 FLY_RISE, FLY_SHARE = 0.06, 0.85
+FLY_SEAM = 0.03  # m below the crotch point the bridge's shared skin weights start (``fly_share``)
 
 
 def across_the_fly(body: AuthoringBody, mesh: Mesh) -> Mesh:
@@ -172,18 +173,20 @@ def across_the_fly(body: AuthoringBody, mesh: Mesh) -> Mesh:
 def fly_share(body: AuthoringBody, mesh: Mesh) -> np.ndarray:
     """(N,) in [0, 1]: how far each vertex's skin weights are blended towards the mean of
     its own and its mirror twin's (``weights.shared_across``): 1 over the middle of the
-    fly (``across_the_fly``'s cloth between the thighs, from FLY_RISE above the crotch
-    point up to the hip joints), falling to 0 at the thighs' crowns and at the crotch
-    point. Laid across from thigh to thigh, the bridge kept the weights of the groin under
-    it, left thigh on its left half and right on its right, a few cm off the skin:
-    mid-stride the legs swung its halves apart and together and the heavy man's shorts
-    crumpled into a pinch at the top of the crotch."""
+    fly (``across_the_fly``'s cloth between the thighs, from FLY_RISE - FLY_SEAM above the
+    crotch point up to the hip joints), falling to 0 at the thighs' crowns and FLY_SEAM
+    below the crotch point (the crotch seam's front shares too: from the crotch point up
+    only, the bridge's bottom row still creased over the trailing thigh). Laid across from
+    thigh to thigh, the bridge kept the weights of the groin under it, left thigh on its
+    left half and right on its right, a few cm off the skin: mid-stride the legs swung its
+    halves apart and together and the heavy man's shorts crumpled into a pinch at the top
+    of the crotch."""
     v = mesh.vertices.astype(np.float64)
     hip = body.marks.hip
     reach = abs(float(hip[0, 0]))
     crotch = float(v[np.abs(v[:, 0]) < 0.015, 2].min())
     front = (v[:, 1] < hip[0, 1]) & (v[:, 2] < hip[0, 2])
-    t = np.clip((v[:, 2] - crotch) / FLY_RISE, 0, 1)
+    t = np.clip((v[:, 2] - crotch + FLY_SEAM) / FLY_RISE, 0, 1)
     across = np.clip(1 - np.abs(v[:, 0]) / reach, 0, 1)
     return np.where(front, t * t * (3 - 2 * t) * across, 0.0)
 

@@ -263,11 +263,17 @@ def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None
 def _frame_weights(garment: Garment, w: SkinWeights) -> SkinWeights:
     """(N, K) the weights frames skin ``garment``'s surface with: its 4 largest, except
     where a skirt's weights ramp (``weights.swing``): there up to 8 bones each fade in and
-    out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices."""
+    out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices;
+    and over a bridge across the fly (``weights.shared_across``: both legs' thighs, the
+    spine and pelvis, up to 21% of a vertex's weight past the 4th, dropped unevenly)."""
     limited = w.limit(FRAME_INFLUENCES)
-    if garment.swing_below is None or limited is w:
+    if (garment.swing_below is None and garment.fly_share is None) or limited is w:
         return limited
-    held = garment.mesh.vertices[:, 2] >= garment.swing_below
+    held = np.ones(len(garment.mesh.vertices), bool)
+    if garment.swing_below is not None:
+        held &= garment.mesh.vertices[:, 2] >= garment.swing_below
+    if garment.fly_share is not None:
+        held &= garment.fly_share <= 0
     idx, wt = w.indices.copy(), w.weights.copy()
     idx[held], wt[held] = 0, 0.0
     k = limited.indices.shape[1]
