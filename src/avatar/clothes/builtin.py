@@ -59,18 +59,24 @@ class Spec:
     # A skirt: its skin weights ramp from the hips to the hem below the hip joints
     # (``Garment.swing_below``), so its hem bends as one curve mid-stride.
     swing: bool = False
+    # Loose trousers spanning the front of the crotch (``across_the_fly``): the bridge's
+    # skin weights shared between its left and right halves (``Garment.fly_share``).
+    fly: bool = False
 
 
-def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0,
-            snug: float | None = None, bridge: bool = False) -> Piece:  # fmt: skip
+def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0, snug: float | None = None,
+            bridge: bool = False, fly: bool = False) -> Piece:  # fmt: skip
     """A garment cut from ``helper-tights``; ``band`` > 0: a rib/hem band that wide (m)
     along every open edge (``authoring.banded``); ``snug``: m off the skin a stretch
     garment is laid at (``tailoring.hug_skin``) instead of ``ease`` off the shell;
-    ``bridge``: loose cloth spanning the body's hollows (``bridged``)."""
+    ``bridge``: loose cloth spanning the body's hollows (``bridged``); ``fly``: loose
+    trousers spanning the front of the crotch (``across_the_fly``)."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX, sided=bridge)
     mesh = level_hems(mesh)
+    if fly:
+        mesh = across_the_fly(body, mesh)
     if bridge:
         mesh = spread_across(body, spanned(body, bridged(body, mesh)))
     if snug is not None:
@@ -126,6 +132,75 @@ def spanned(body: AuthoringBody, mesh: Mesh) -> Mesh:
     lift = np.where(between, np.clip(v[np.maximum(crown, 0), 1] - v[:, 1], 0, None), 0.0)
     v[:, 1] += share * lift
     return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+# Loose trousers across the front of the crotch: from the crotch point up, the cloth over
+# the groin is laid FLY_SHARE of the way out to the thighs' fronts (reached FLY_RISE m above
+# the crotch point, from nothing there: the crotch seam still runs back between the legs).
+FLY_RISE, FLY_SHARE = 0.06, 0.85
+FLY_SEAM = 0.03  # m below the crotch point the bridge's shared skin weights start (``fly_share``)
+
+
+def across_the_fly(body: AuthoringBody, mesh: Mesh) -> Mesh:
+    """Loose trousers spanning the front of the crotch from thigh to thigh: each vertex
+    on the front between the hip joints brought towards the depth of the cloth's
+    front-most vertex about its height (the thighs' crowns), never back. Cut from the
+    tights shell, sweatpants, trousers, shorts and jeans followed the groin: seen from the
+    front, 5-8 cm above the crotch point their cloth at the midline stood 44-75 mm behind
+    the cloth over the thighs, a deep V (a camel toe) on women and children. Vertices whose
+    cloth faces back (the crotch's gusset between the legs, the far wall of the seam's
+    curve) stay: laid flat with the rest, the small faces round the front crotch seam
+    folded over (2-8 turned back, specks on the fly). Moving forward over the groin only
+    takes the cloth further off the skin."""
+    v = mesh.vertices.astype(np.float64)
+    hip = body.marks.hip
+    reach = abs(float(hip[0, 0]))  # the thighs' crowns lie within a hip joint's x of the midline
+    crotch = float(v[np.abs(v[:, 0]) < 0.015, 2].min())
+    front = (v[:, 1] < hip[0, 1]) & (np.abs(v[:, 0]) < reach)
+    pick = np.flatnonzero(front & (v[:, 2] > crotch) & (v[:, 2] < hip[0, 2]))
+    if len(pick) == 0:
+        return mesh
+    crowns = np.flatnonzero(front)
+    row = np.abs(v[pick, None, 2] - v[None, crowns, 2]) < 0.03  # (P, C) about level
+    depth = np.where(row, v[None, crowns, 1], np.inf).min(axis=1)  # front-most y per row
+    t = np.clip((v[pick, 2] - crotch) / FLY_RISE, 0, 1)
+    facing = np.clip((0.2 - _vertex_normals(v, mesh.faces)[pick, 1]) / 0.4, 0, 1)
+    share = FLY_SHARE * t * t * (3 - 2 * t) * facing
+    v[pick, 1] -= share * np.clip(v[pick, 1] - depth, 0, None)
+    return Mesh(v.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+def fly_share(body: AuthoringBody, mesh: Mesh) -> np.ndarray:
+    """(N,) in [0, 1]: how far each vertex's skin weights are blended towards the mean of
+    its own and its mirror twin's (``weights.shared_across``): 1 over the middle of the
+    fly (``across_the_fly``'s cloth between the thighs, from FLY_RISE - FLY_SEAM above the
+    crotch point up to the hip joints), falling to 0 at the thighs' crowns and FLY_SEAM
+    below the crotch point (the crotch seam's front shares too: from the crotch point up
+    only, the bridge's bottom row still creased over the trailing thigh). Laid across from
+    thigh to thigh, the bridge kept the weights of the groin under it, left thigh on its
+    left half and right on its right, a few cm off the skin: mid-stride the legs swung its
+    halves apart and together and the heavy man's shorts crumpled into a pinch at the top
+    of the crotch."""
+    v = mesh.vertices.astype(np.float64)
+    hip = body.marks.hip
+    reach = abs(float(hip[0, 0]))
+    crotch = float(v[np.abs(v[:, 0]) < 0.015, 2].min())
+    front = (v[:, 1] < hip[0, 1]) & (v[:, 2] < hip[0, 2])
+    t = np.clip((v[:, 2] - crotch + FLY_SEAM) / FLY_RISE, 0, 1)
+    across = np.clip(1 - np.abs(v[:, 0]) / reach, 0, 1)
+    return np.where(front, t * t * (3 - 2 * t) * across, 0.0)
+
+
+def _vertex_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(N, 3) unit normals of a quad mesh's vertices, turned to face out of the body (most
+    of a garment's faces face away from its centre)."""
+    normal = np.cross(v[faces[:, 2]] - v[faces[:, 0]], v[faces[:, 3]] - v[faces[:, 1]])
+    if np.einsum("nd,nd->", normal, v[faces].mean(axis=1) - v.mean(axis=0)) < 0:
+        normal = -normal
+    out = np.zeros_like(v)
+    for k in range(faces.shape[1]):
+        np.add.at(out, faces[:, k], normal)
+    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
 
 
 def spread_across(body: AuthoringBody, mesh: Mesh, passes: int = 8) -> Mesh:
@@ -224,6 +299,7 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
     mesh = cut(body, faces, bottom(length, RISE)(ff, body.marks), ease, relax=RELAX)
     mesh = level_hems(Mesh(tailoring.straight_legs(body, mesh.vertices.astype(np.float64), hang,
                                                    taper=taper).astype(np.float32), mesh.faces))
+    mesh = across_the_fly(body, mesh)
     panels = tailoring.Panels(mesh, tailoring.TROUSER_PANELS, tailoring.leg_axis(body.marks))
     band = 0.04 if kind == "jeans" else 0.035
     h = tailoring.heights(mesh, body.marks, band)
@@ -730,10 +806,10 @@ SPECS = [
     Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
     Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
-    Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02)), "canvas", "khaki", 0.002, 35, ("shorts",)),  # noqa: E501
-    Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal")),  # noqa: E501
-    Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow", 0.92), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants")),  # noqa: E501
-    Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly")),  # noqa: E501
+    Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02), fly=True), "canvas", "khaki", 0.002, 35, ("shorts",), fly=True),  # noqa: E501
+    Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal"), fly=True),  # noqa: E501
+    Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow", 0.92), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants"), fly=True),  # noqa: E501
+    Spec("sweatpants", "bottoms", lambda b: _tights(b, bottom(0.95), flare(0.012, 0.02, 0.1), 0.03, fly=True), "jersey", "grey", 0.002, 35, ("sweatpants", "joggers", "children", "elderly"), fly=True),  # noqa: E501
     Spec("leggings", "bottoms", lambda b: _tights(b, bottom(0.95), 0.0015, snug=SNUG), "lycra", "black", SNUG_THICKNESS, 25, ("leggings", "sport")),  # noqa: E501
     Spec("skirt", "bottoms", lambda b: _skirt(b, b.marks.knee[0, 2] + 0.1, _skirt_ease(b, 0.004, 0.03), tailor=True), "cotton", "red", 0.0015, 36, ("skirt",), clearance=0.006, swing=True),  # noqa: E501
     Spec("dress", "dresses", _dress, "cotton", "teal", DRESS_THICKNESS, 38, ("dress",), clearance=DRESS_CLEARANCE, swing=True),  # noqa: E501
@@ -804,4 +880,5 @@ def assemble(spec: Spec, piece: Piece, body: AuthoringBody, texture_size: int = 
         source="builtin",
         licence="CC0 (generated by Avatar from MakeHuman's CC0 base mesh)",
         swing_below=float(body.marks.hip[:, 2].mean()) if spec.swing else None,
+        fly_share=fly_share(body, piece.mesh) if spec.fly else None,
     )

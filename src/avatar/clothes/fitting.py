@@ -48,6 +48,8 @@ class Garment:
     collide: False for face proxies (eyebrows, eyelashes) that sit on the skin by design.
     swing_below: m (height on the authored mesh); a skirt's transferred skin weights are
         smoothed over its cloth below it (``weights.swing``). None: as transferred.
+    fly_share: (N,) loose trousers' bridge across the fly: each vertex's transferred
+        weights shared this much with its mirror twin's (``weights.shared_across``).
     delete_verts: (D,) int32 base-mesh vertices the garment covers (hidden if the user asks).
     """
 
@@ -66,6 +68,7 @@ class Garment:
     source: str = "builtin"
     licence: str = ""
     swing_below: float | None = None
+    fly_share: np.ndarray | None = None
 
     @cached_property
     def anchor_cache(self) -> dict:
@@ -263,6 +266,8 @@ def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None
         result = weights.transfer(garment.binding, body_weights)
         if garment.swing_below is not None:
             result = weights.swing(result, garment.mesh, garment.swing_below)
+        if garment.fly_share is not None:
+            result = weights.shared_across(result, garment.mesh, garment.fly_share)
     garment.weight_cache[:] = [(body_weights, names, result)]  # holds body_weights: no id reuse
     return result
 
@@ -270,11 +275,17 @@ def garment_weights(garment: Garment, body_weights: SkinWeights, bone_names=None
 def _frame_weights(garment: Garment, w: SkinWeights) -> SkinWeights:
     """(N, K) the weights frames skin ``garment``'s surface with: its 4 largest, except
     where a skirt's weights ramp (``weights.swing``): there up to 8 bones each fade in and
-    out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices."""
+    out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices;
+    and over a bridge across the fly (``weights.shared_across``: both legs' thighs, the
+    spine and pelvis, up to 21% of a vertex's weight past the 4th, dropped unevenly)."""
     limited = w.limit(FRAME_INFLUENCES)
-    if garment.swing_below is None or limited is w:
+    if (garment.swing_below is None and garment.fly_share is None) or limited is w:
         return limited
-    held = garment.mesh.vertices[:, 2] >= garment.swing_below
+    held = np.ones(len(garment.mesh.vertices), bool)
+    if garment.swing_below is not None:
+        held &= garment.mesh.vertices[:, 2] >= garment.swing_below
+    if garment.fly_share is not None:
+        held &= garment.fly_share <= 0
     idx, wt = w.indices.copy(), w.weights.copy()
     idx[held], wt[held] = 0, 0.0
     k = limited.indices.shape[1]

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from scipy.sparse import csr_matrix
+from scipy.spatial import cKDTree
 
 from avatar.clothes.binding import Binding
 from avatar.io.mhw import BoneWeights
@@ -127,6 +128,29 @@ def swing(
     idx[free], w[free] = 0, 0.0
     idx[free, :influences], w[free, :influences] = ramped.indices[free], ramped.weights[free]
     return SkinWeights(idx, w)
+
+
+def shared_across(weights: SkinWeights, mesh: Mesh, share: np.ndarray) -> SkinWeights:
+    """Weights of cloth spanning the body's midline blended with their mirror twins': each
+    vertex keeps 1 - share/2 of its own and takes share/2 of its twin's (the vertex
+    nearest its mirror image in x), so where share is 1 both halves move as one piece (the
+    mean of the left and right legs' motion: the pelvis's, mid-stride).
+
+    weights: (N, K); mesh: the garment's N authored vertices (symmetric about x = 0);
+    share: (N,) in [0, 1]. Returns (N, K) SkinWeights; vertices with share 0 as given.
+    """
+    pick = np.flatnonzero(share > 0)
+    if len(pick) == 0:
+        return weights
+    v = mesh.vertices.astype(np.float64)
+    _, twin = cKDTree(v).query(v[pick] * np.array([-1.0, 1.0, 1.0]))
+    half = share[pick, None] / 2
+    bone = np.concatenate([weights.indices[pick], weights.indices[twin]], axis=1)
+    w = np.concatenate([weights.weights[pick] * (1 - half), weights.weights[twin] * half], axis=1)
+    blended = _merge(bone, w, weights.indices.shape[1])
+    idx, wt = weights.indices.copy(), weights.weights.copy()
+    idx[pick], wt[pick] = blended.indices, blended.weights
+    return SkinWeights(idx, wt)
 
 
 def _neighbour_mean(mesh: Mesh, rows: np.ndarray) -> csr_matrix:
