@@ -310,7 +310,7 @@ def armhole_curve(panels: JacketPanels, k: int, offset: float = 0.005):
     just below the stepped edge everywhere. Under the arm the chart's top row flares out
     (u is the angle times a growing radius) over nothing: the curve stops where the
     chart under it (down to its stitching, ``offset`` m lower) ends."""
-    from scipy.ndimage import gaussian_filter1d, minimum_filter1d
+    from scipy.ndimage import gaussian_filter1d, maximum_filter1d, minimum_filter1d
 
     uz = armhole_boundary(panels, k)
     bins = np.round(uz[:, 0] / 0.01).astype(int)
@@ -322,6 +322,11 @@ def armhole_curve(panels: JacketPanels, k: int, offset: float = 0.005):
     # A step's foot reaches a bin or so either side of it: the envelope, then the blur.
     z = gaussian_filter1d(minimum_filter1d(low, 3, mode="nearest"), ARMHOLE_SMOOTH / 0.01,
                           mode="nearest")  # fmt: skip
+    # Lowered where a step's foot still pokes under it (locally, so the curve keeps to
+    # the edge elsewhere), then by whatever still does.
+    above = np.zeros(len(u))
+    np.maximum.at(above, bins - bins.min(), np.interp(uz[:, 0], u, z) - uz[:, 1])
+    z = z - gaussian_filter1d(maximum_filter1d(above, 5, mode="nearest"), 1.0, mode="nearest")
     z = z - max(float((np.interp(uz[:, 0], u, z) - uz[:, 1]).max()), 0.0) - 0.002
     covered = _in_chart(panels, k, np.stack([u, z], -1)) & _in_chart(
         panels, k, np.stack([u, z - offset], -1))
