@@ -160,3 +160,58 @@ def test_jacket_opening_has_no_lone_raised_patch(piece):
     over = [(a, b) for a, b in pairs
             if opening[a] and np.dot(normal[a], normal[b]) > 0.9]  # fmt: skip
     assert not over, centre[[a for a, _ in over]]
+
+
+def _uv_to_3d(mesh, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((N, 3) points, (N,) face or -1) of UV points (N, 2): each quad as two triangles."""
+    f, fu = mesh.faces, mesh.face_uvs
+    tri_v = np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
+    tri_f = np.concatenate([np.arange(len(f))] * 2)
+    a, b, c = (mesh.uvs[np.concatenate([fu[:, [0, 1, 2]], fu[:, [0, 2, 3]]])[:, i]]
+               .astype(float) for i in range(3))  # fmt: skip
+    e1, e2 = b - a, c - a
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    out, face = np.zeros((len(uv), 3)), np.full(len(uv), -1)
+    for i, p in enumerate(uv):
+        d = p - a
+        s = (d[:, 0] * e2[:, 1] - d[:, 1] * e2[:, 0]) / det
+        t = (e1[:, 0] * d[:, 1] - e1[:, 1] * d[:, 0]) / det
+        hit = np.flatnonzero((s >= -1e-9) & (t >= -1e-9) & (s + t <= 1 + 1e-9))
+        if len(hit):
+            j = hit[0]
+            corner = mesh.vertices[tri_v[j]].astype(float)
+            out[i] = corner[0] + s[j] * (corner[1] - corner[0]) + t[j] * (corner[2] - corner[0])
+            face[i] = tri_f[j]
+    return out, face
+
+
+@pytest.mark.parametrize("sleeve", jacket.SLEEVES)
+def test_jacket_armhole_stitching_runs_without_a_jog(body, piece, sleeve):
+    """The armhole's topstitching (on the sleeve, within 3 cm of where sleeve meets body)
+    must run as one line round the shoulder, front and back down to armpit height: within
+    any 5 mm of the sleeve chart's u (the arc round the arm) its points lie within 1 cm
+    of each other on the jacket. Drawn along the faces' staircase it stepped sideways by
+    a face at the back of the armhole (3.2 cm within 5 mm of u; 5 mm now)."""
+    panels = jacket.JacketPanels(body, piece.mesh)
+    f = piece.mesh.faces
+    on = [np.zeros(len(piece.mesh.vertices), bool) for _ in range(2)]
+    on[0][f[panels.face_panel == sleeve].ravel()] = True
+    on[1][f[panels.face_panel < jacket.SLEEVES[0]].ravel()] = True
+    ring = piece.mesh.vertices[on[0] & on[1]]  # the armhole, where sleeve meets body
+    points = []
+    for mark in _kinds(piece, "stitch"):
+        p = mark.points
+        for s0, s1 in p if p.ndim == 3 else np.stack([p[:-1], p[1:]], 1):
+            n = max(2, int(np.linalg.norm(s1 - s0) / panels.scale / 0.002))  # every 2 mm
+            points.append(s0 + np.linspace(0, 1, n)[:, None] * (s1 - s0))
+    uv = np.concatenate(points)
+    uz = uv / panels.scale + [panels.u0[sleeve], panels.z_lo[sleeve]]
+    # Round the top of the arm only: under it the chart flares (u is angle x radius).
+    over = (np.abs(uz[:, 0]) < 0.17) & (uz[:, 1] > panels.lo[sleeve, 1])
+    where, face = _uv_to_3d(piece.mesh, uv[over])
+    near = np.linalg.norm(where[:, None] - ring[None], axis=2).min(axis=1) < 0.03
+    near &= (face >= 0) & (panels.face_panel[face] == sleeve)
+    bins = np.round(uz[over][near, 0] / 0.005).astype(int)
+    assert len(np.unique(bins)) > 50  # the line runs the whole way round the top
+    jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
+    assert jog < 0.01, f"armhole stitching steps {jog * 1000:.0f} mm sideways"

@@ -200,10 +200,11 @@ def _box(centre: np.ndarray, width: float, height: float, tilt: float) -> np.nda
     return centre + corners @ np.array([[c, s], [-s, c]])
 
 
-def topstitched_seams(panels: JacketPanels, offset: float = 0.005) -> list[Mark]:
-    """The panels' seams (``Panels.seams``) and a row of topstitching ``offset`` m beside
-    each, on the panel's own side (leather seams are pressed open and topstitched)."""
-    seams = panels.seams()
+def topstitched_seams(panels: JacketPanels, offset: float = 0.005, keep=None) -> list[Mark]:
+    """The panels' seams (``Panels.seams``, those ``keep`` picks) and a row of topstitching
+    ``offset`` m beside each, on the panel's own side (leather seams are pressed open and
+    topstitched)."""
+    seams = panels.seams(keep)
     if not seams:
         return []
     segments = seams[0].points  # (M, 2, 2) uv, both sides of every seam
@@ -227,7 +228,13 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
     """A zip-front jacket: topstitched side, shoulder, centre-back, armhole and underarm
     seams; a zip down each front's opening; two lower welt pockets and a chest pocket; a
     back yoke; a hem band, cuffs and a collar band, each sewn on and topstitched."""
-    out = topstitched_seams(panels)
+    # The armhole is drawn smooth in the sleeve's chart (``armhole``), not along the faces'
+    # staircase where sleeve meets body: that stepped sideways by a face under the arm.
+    curves = {k: armhole_curve(panels, k)[0] for k in SLEEVES}
+    spans = {k: (float(u[0]), float(u[-1])) for k, u in curves.items() if len(u)}
+    out = topstitched_seams(panels, keep=_drawn_smooth(panels, spans))
+    for k in SLEEVES:
+        out += armhole(panels, k)
     for k in BODY:
         hem = float(panels.lo[k, 1])
         band = hem + 0.045  # the hem band's seam
@@ -272,6 +279,103 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
     return out
 
 
+def armhole_boundary(panels: JacketPanels, k: int) -> np.ndarray:
+    """(N, 2) points (u, z) of sleeve k's chart along the edges it shares with the body
+    panels (a staircase of face edges), 10 a face edge."""
+    f = panels.mesh.faces
+    on_body = np.zeros(len(panels.mesh.vertices), bool)
+    on_body[f[panels.face_panel < SLEEVES[0]].reshape(-1)] = True
+    mine = np.flatnonzero(panels.face_panel == k)
+    corner = on_body[f[mine]]  # (S, C) corners shared with a body face
+    edge = corner & np.roll(corner, -1, axis=1)
+    fi, ci = np.nonzero(edge)
+    p0 = panels.corner_uz[mine[fi], ci]
+    p1 = panels.corner_uz[mine[fi], (ci + 1) % f.shape[1]]
+    t = np.linspace(0.0, 1.0, 10)[:, None, None]
+    return (p0 + t * (p1 - p0)).reshape(-1, 2)
+
+
+def armhole(panels: JacketPanels, k: int, offset: float = 0.005) -> list[Mark]:
+    """Sleeve k's armhole seam, its allowance's ridge and topstitching ``offset`` m down
+    the sleeve along ``armhole_curve``."""
+    u, z = armhole_curve(panels, k, offset)
+    return [Mark("seam", _line(panels, k, u, z)),
+            Mark("fold", _line(panels, k, u, z - 0.5 * offset), 0.0025, ALLOWANCE),
+            Mark("stitch", _line(panels, k, u, z - offset), 0.0008)]
+
+
+def armhole_curve(panels: JacketPanels, k: int, offset: float = 0.005):
+    """(u (N,), z (N,)) of sleeve k's armhole seam in its chart: one smooth curve round
+    the arm (the stepped edge's lowest point each cm of u, blurred over ARMHOLE_SMOOTH m)
+    just below the stepped edge everywhere. Under the arm the chart's top row flares out
+    (u is the angle times a growing radius) over nothing: the curve stops where the
+    chart under it (down to its stitching, ``offset`` m lower) ends."""
+    from scipy.ndimage import gaussian_filter1d, maximum_filter1d, minimum_filter1d
+
+    uz = armhole_boundary(panels, k)
+    bins = np.round(uz[:, 0] / 0.01).astype(int)
+    u = np.arange(bins.min(), bins.max() + 1) * 0.01
+    lowest = np.full(len(u), np.inf)
+    np.minimum.at(lowest, bins - bins.min(), uz[:, 1])
+    known = np.isfinite(lowest)
+    low = np.interp(u, u[known], lowest[known])
+    # A step's foot reaches a bin or so either side of it: the envelope, then the blur.
+    z = gaussian_filter1d(minimum_filter1d(low, 3, mode="nearest"), ARMHOLE_SMOOTH / 0.01,
+                          mode="nearest")  # fmt: skip
+    # Lowered where a step's foot still pokes under it (locally, so the curve keeps to
+    # the edge elsewhere), then by whatever still does.
+    above = np.zeros(len(u))
+    np.maximum.at(above, bins - bins.min(), np.interp(uz[:, 0], u, z) - uz[:, 1])
+    z = z - gaussian_filter1d(maximum_filter1d(above, 5, mode="nearest"), 1.0, mode="nearest")
+    z = z - max(float((np.interp(uz[:, 0], u, z) - uz[:, 1]).max()), 0.0) - 0.002
+    covered = _in_chart(panels, k, np.stack([u, z], -1)) & _in_chart(
+        panels, k, np.stack([u, z - offset], -1))
+    run = _longest_run(covered)
+    return u[run], z[run]
+
+
+def _in_chart(panels: JacketPanels, k: int, uz: np.ndarray) -> np.ndarray:
+    """(N,) bool: points (N, 2) inside one of chart k's faces (each quad as 2 triangles)."""
+    quads = panels.corner_uz[panels.face_panel == k]
+    tri = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    a, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    d = uz[:, None] - a[None]  # (N, T, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (d[..., 0] * e2[:, 1] - d[..., 1] * e2[:, 0]) / det
+        t = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
+    return ((s >= 0) & (t >= 0) & (s + t <= 1)).any(axis=1)
+
+
+def _longest_run(mask: np.ndarray) -> slice:
+    """The longest stretch of True in mask (N,)."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
+    starts, ends = edges[::2], edges[1::2]
+    if not len(starts):
+        return slice(0, 0)
+    i = int(np.argmax(ends - starts))
+    return slice(int(starts[i]), int(ends[i]))
+
+
+def _drawn_smooth(panels: JacketPanels, curves: dict):
+    """``Panels.seams`` keep: every seam but the armhole's edges whose sleeve face lies
+    within u of its smooth curve (``curves``: sleeve -> (u lo, u hi))."""
+    centre_u = panels.corner_uz[:, :, 0].mean(axis=1)
+
+    def keep(fa: np.ndarray, fb: np.ndarray) -> np.ndarray:
+        out = np.ones(len(fa), bool)
+        for k, (lo, hi) in curves.items():
+            for sleeve, other in ((fa, fb), (fb, fa)):
+                mine = (panels.face_panel[sleeve] == k) & (panels.face_panel[other] < SLEEVES[0])
+                out &= ~(mine & (centre_u[sleeve] >= lo) & (centre_u[sleeve] <= hi))
+        return out
+
+    return keep
+
+
+ARMHOLE_SMOOTH = 0.02  # m (along u) the armhole's curve is blurred over: a face and a bit
+
+
 def _zip(panels: JacketPanels, k: int, bottom: float, top: float) -> list[Mark]:
     """Half a zip along a front's opening: the tape's edge, a row of metal teeth 3 mm in
     and the tape's topstitching 1.2 cm in; the pull on the wearer's left."""
@@ -313,4 +417,5 @@ def tailored(body: AuthoringBody, piece: Piece) -> Piece:
     return replace(piece, mesh=panels.textured(), layout=layout)
 
 
-__all__ = ["PANELS", "JacketPanels", "jacket_marks", "tailored", "topstitched_seams"]
+__all__ = ["PANELS", "JacketPanels", "armhole", "armhole_boundary", "armhole_curve",
+           "jacket_marks", "tailored", "topstitched_seams"]  # fmt: skip

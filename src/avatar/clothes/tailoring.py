@@ -136,9 +136,10 @@ class Panels:
         known = ~np.isnan(pick)
         return np.interp(z, steps[known], pick[known])
 
-    def seams(self) -> list[Mark]:
+    def seams(self, keep=None) -> list[Mark]:
         """Seams along the edges where two panels meet (outseams, inseams, centre seams),
-        drawn on both sides of each."""
+        drawn on both sides of each; ``keep(face_a, face_b)`` (index arrays) -> bool mask,
+        if given, picks which of those edges (a garment drawing some seams its own way)."""
         f = self.mesh.faces
         c = f.shape[1]
         a, b = f.reshape(-1), np.roll(f, -1, axis=1).reshape(-1)
@@ -149,6 +150,8 @@ class Panels:
         same = key[order][1:] == key[order][:-1]
         first, second = order[:-1][same], order[1:][same]
         cross = self.face_panel[face[first]] != self.face_panel[face[second]]
+        if keep is not None:
+            cross &= keep(face[first], face[second])
         segments = []
         for half in (first[cross], second[cross]):
             fi, ci = face[half], corner[half]
