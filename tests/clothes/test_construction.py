@@ -319,3 +319,24 @@ def test_dress_skirt_has_no_crease_down_its_sides(params):
     centre = v[faces[a]].mean(axis=1)[:, 2]
     skirt = (centre < hips - 0.03) & (centre > v[:, 2].min() + 0.05)  # above the hem's band
     assert _fold_degrees(v, faces, a, b)[skirt].max() < 30
+
+
+def _mark_colours(name: str, kind: str) -> np.ndarray:
+    """(M, 3) sRGB (0-255) of a garment's texture at the centres of its ``kind`` marks."""
+    garment = library.load_garment(name, texture_size=1024)
+    piece = builtin.BY_NAME[name].make(library.authoring_body())
+    image = garment.material.base_color_texture
+    size = image.shape[0]
+    centres = np.array([m.points.reshape(-1, 2).mean(axis=0) for m in _kinds(piece, kind)])
+    px = np.clip((centres * [1, -1] + [0, 1]) * size, 0, size - 1).astype(int)
+    return image[px[:, 1], px[:, 0], :3].astype(float)
+
+
+def test_trouser_buttons_are_horn_and_jeans_rivets_copper():
+    """Wool trousers' buttons were painted in the jeans' copper (orange dots on a grey
+    suit's back pockets, read as rivets); they are dark horn now, and jeans keep copper."""
+    buttons = _mark_colours("trousers", "button")
+    assert len(buttons) >= 3
+    assert (buttons.max(axis=1) < 80).all() and (np.ptp(buttons, axis=1) < 25).all(), buttons
+    rivets = _mark_colours("jeans", "rivet")
+    assert (rivets[:, 0] > rivets[:, 2] + 30).all(), rivets  # copper: red over blue

@@ -309,7 +309,8 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
     mesh = level_hems(mesh, reach=0.012)  # the bands' inner edges, as the hems
     marks = (tailoring.jeans_marks if kind == "jeans" else tailoring.trouser_marks)(panels, h)
     piece = join([bound(body, mesh, faces), tailoring.belt_loops(body, mesh, h, faces)])
-    return replace(piece, layout=tailoring.layout(panels, marks, thread))
+    metal = None if kind == "jeans" else tailoring.HORN
+    return replace(piece, layout=tailoring.layout(panels, marks, thread, metal))
 
 
 def _z(ff):

@@ -563,9 +563,15 @@ def _facing(mesh: Mesh, inside: np.ndarray) -> Mesh:
     return Mesh(mesh.vertices, faces, mesh.uvs, face_uvs)
 
 
-def layout(panels: Panels, marks: list[Mark], thread: str) -> Layout:
+# Buttons and rivets: jeans' copper (Layout's default); tailored trousers' horn buttons, as
+# dark as the wool (copper read as jeans rivets on a grey suit).
+HORN = (0.035, 0.028, 0.022)
+
+
+def layout(panels: Panels, marks: list[Mark], thread: str, metal=None) -> Layout:
     names = [p.name for p in panels.panels]
-    return Layout(panels.scale, tuple(marks), thread, extras={"panels": names})
+    extra = {} if metal is None else {"metal": metal}
+    return Layout(panels.scale, tuple(marks), thread, extras={"panels": names}, **extra)
 
 
 __all__ = [
