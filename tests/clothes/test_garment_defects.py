@@ -1042,3 +1042,23 @@ def test_jacket_over_a_tshirt_holds_still_at_rest(params):
     fitted = human.outfit.garments[i].mesh.vertices
     jump = np.linalg.norm(frame[i] - fitted[: len(frame[i])], axis=1)
     assert jump.max() < 0.007, jump.max()
+
+
+# ---------------------------------------------------------------------------- straps
+
+
+@pytest.mark.parametrize("name", ["dress", "swimsuit", "tanktop"])
+@pytest.mark.parametrize("params", [WOMAN, {"gender": 0.0, "age": 0.7, "weight": 0.9}])
+def test_straps_end_across_the_shoulder_without_a_tab(name, params):
+    """A strap runs over the top of the shoulder, no higher than the base of the neck.
+    The faces just outside the neckline that climb the side of the neck were kept: each
+    strap's inner corner stood up as a tab 19-26 mm above the neck joint (a slim and a
+    heavy woman), against 2-12 mm for the strap across the shoulder."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    human = Human(params).dressed(name)
+    v = human.outfit.garments[0].mesh.vertices.astype(np.float64)
+    marks = AuthoringBody(human.body).marks
+    for shoulder in marks.shoulder:
+        side = v[:, 0] * np.sign(shoulder[0]) > 0.02
+        assert v[side, 2].max() - marks.neck[2] < 0.015, (name, v[side, 2].max() - marks.neck[2])

@@ -362,9 +362,16 @@ def strapped(hem: float, armhole: float = 0.062, front: float = 0.12, back: floa
         neckline = m.neck[2] - depth * np.sqrt(np.clip(1 - (across / 0.07) ** 2, 0, 1))
         upper = (ff.part == "torso") | ((ff.part == "arm") & (across < shoulder_x - 0.03))
         body = upper & (z > m.hip[0, 2] + hem) & (hole > 1) & (across < shoulder_x)
+        body &= z < m.neck[2] - STRAP_TOP
         return body & ~((across < 0.07) & (z > neckline))
 
     return keep
+
+
+# m below the neck joint at which straps end across the top of the shoulder: the faces just
+# outside the neckline climbing the side of the neck (centres up to 4 mm above the joint)
+# stood up from each strap's inner corner as a 1-2 cm tab.
+STRAP_TOP = 0.008
 
 
 # Stretch garments (lycra) lie SNUG m off the skin, as SNUG_THICKNESS m of cloth: closer,
