@@ -24,7 +24,7 @@ SETS = {
     "cuffs": [(CHILD, ("longsleeve",)), (CHILD, ("hoodie",)), (CHILD, ("tshirt", "cardigan"))],
 }
 # metres between bodies, frame height / width per body, aim height (m)
-FRAMING = {"straps": (0.42, 0.8, 1.2), "cuffs": (0.62, 0.6, 0.62)}
+FRAMING = {"straps": (0.42, 0.8, 1.2), "cuffs": (0.8, 0.45, 0.8)}
 
 
 def main() -> None:
