@@ -1042,3 +1042,56 @@ def test_jacket_over_a_tshirt_holds_still_at_rest(params):
     fitted = human.outfit.garments[i].mesh.vertices
     jump = np.linalg.norm(frame[i] - fitted[: len(frame[i])], axis=1)
     assert jump.max() < 0.007, jump.max()
+
+
+# ---------------------------------------------------------------------------- straps
+
+
+@pytest.mark.parametrize("name", ["dress", "swimsuit", "tanktop"])
+@pytest.mark.parametrize("params", [WOMAN, {"gender": 0.0, "age": 0.7, "weight": 0.9}])
+def test_straps_end_across_the_shoulder_without_a_tab(name, params):
+    """A strap runs over the top of the shoulder, no higher than the base of the neck.
+    The faces just outside the neckline that climb the side of the neck were kept: each
+    strap's inner corner stood up as a tab 19-26 mm above the neck joint (a slim and a
+    heavy woman), against 2-12 mm for the strap across the shoulder."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    human = Human(params).dressed(name)
+    v = human.outfit.garments[0].mesh.vertices.astype(np.float64)
+    marks = AuthoringBody(human.body).marks
+    for shoulder in marks.shoulder:
+        side = v[:, 0] * np.sign(shoulder[0]) > 0.02
+        assert v[side, 2].max() - marks.neck[2] < 0.015, (name, v[side, 2].max() - marks.neck[2])
+
+
+# ---------------------------------------------------------------------------- cuffs
+
+
+def _sleeve_radii(human: Human) -> tuple[float, float]:
+    """(m) the left sleeve's radius round the forearm's axis (90th percentile of its inner
+    cloth's vertices) over its last 6% of the forearm's length, and 35-45% above its end."""
+    from avatar.clothes.authoring import AuthoringBody
+
+    fitted = human.outfit.garments[-1]
+    v = fitted.mesh.vertices[: len(fitted.garment.mesh.vertices)].astype(np.float64)
+    marks = AuthoringBody(human.body).marks
+    elbow, wrist = marks.elbow[0], marks.wrist[0]
+    length = float(np.linalg.norm(wrist - elbow))
+    rel = v - elbow
+    along = rel @ (wrist - elbow) / length
+    radius = np.linalg.norm(rel - np.outer(along, (wrist - elbow) / length), axis=1)
+    forearm = (v[:, 0] * np.sign(elbow[0]) > abs(elbow[0])) & (along > 0) & (radius < 0.1)
+    end = along[forearm].max()
+    cuff = forearm & (along > end - 0.06 * length)
+    above = forearm & (along < end - 0.35 * length) & (along > end - 0.45 * length)
+    return float(np.percentile(radius[cuff], 90)), float(np.percentile(radius[above], 90))
+
+
+@pytest.mark.parametrize("name", ["longsleeve", "hoodie", "cardigan"])
+@pytest.mark.parametrize("params", [{"age": 0.15}, WOMAN])
+def test_sleeves_gather_into_cuffs_round_the_wrist(name, params):
+    """A knit sleeve closes in round the wrist. Eased as much at its end as along the
+    forearm, it ran on as a straight tube 2.4-2.6 times the wrist's width, a bell round a
+    child's thin wrist (cuff 0.93-1.0 of the radius a third of the forearm above it)."""
+    cuff, above = _sleeve_radii(Human(params).dressed(name))
+    assert cuff < 0.85 * above, (name, round(cuff * 1000), round(above * 1000))

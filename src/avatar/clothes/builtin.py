@@ -363,9 +363,16 @@ def strapped(hem: float, armhole: float = 0.062, front: float = 0.12, back: floa
         neckline = m.neck[2] - depth * np.sqrt(np.clip(1 - (across / 0.07) ** 2, 0, 1))
         upper = (ff.part == "torso") | ((ff.part == "arm") & (across < shoulder_x - 0.03))
         body = upper & (z > m.hip[0, 2] + hem) & (hole > 1) & (across < shoulder_x)
+        body &= z < m.neck[2] - STRAP_TOP
         return body & ~((across < 0.07) & (z > neckline))
 
     return keep
+
+
+# m below the neck joint at which straps end across the top of the shoulder: the faces just
+# outside the neckline climbing the side of the neck (centres up to 4 mm above the joint)
+# stood up from each strap's inner corner as a 1-2 cm tab.
+STRAP_TOP = 0.008
 
 
 # Stretch garments (lycra) lie SNUG m off the skin, as SNUG_THICKNESS m of cloth: closer,
@@ -392,6 +399,26 @@ def flare(base: float, extra: float, start: float = 0.0):
 
 def sleeve_ease(base: float, extra: float):
     return lambda p, arm, leg: base + extra * np.clip(arm, 0, 1)
+
+
+# Where along the arm (0 shoulder, 0.5 elbow, 1 wrist) a knit cuff starts gathering in,
+# and where it has closed to its own ease (the sleeves end at 0.94-0.95).
+CUFF_FROM, CUFF_TO = 0.8, 0.93
+
+
+def cuffed(ease, cuff: float):
+    """``ease`` closing in to ``cuff`` m over the sleeve's last few centimetres: a knit
+    cuff gathered round the wrist. Eased as much as the forearm, a sleeve ran on as a
+    straight tube 2.4-2.6 times the wrist's width, its open end a bell round a child's
+    thin wrist."""
+
+    def eased(p, arm, leg):
+        t = np.clip((arm - CUFF_FROM) / (CUFF_TO - CUFF_FROM), 0, 1)
+        gather = t * t * (3 - 2 * t)  # smoothstep: no kink where the gathering starts
+        loose = ease(p, arm, leg)
+        return loose + (np.minimum(cuff, loose) - loose) * gather
+
+    return eased
 
 
 def shoe_look(upper: str, upper_colour: str, sole_colour: str, lace_colour: str | None = None,
@@ -777,8 +804,9 @@ def _clear_rings(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
 
 
 def _hoodie(body: AuthoringBody) -> Piece:
-    top_piece = _tights(body, top(0.95, neck=-HOODIE_NECK, hem=-0.02), sleeve_ease(0.013, 0.012),
-                        0.03, bridge=True)  # fmt: skip
+    sleeves = cuffed(sleeve_ease(0.013, 0.012), 0.004)
+    top_piece = _tights(body, top(0.95, neck=-HOODIE_NECK, hem=-0.02), sleeves, 0.03,
+                        bridge=True)  # fmt: skip
     pocket = _tights(body, _kangaroo_pocket, 0.017, 0.012)
     collar = _hood_collar(body, top_piece.mesh)
     return join([top_piece, pocket, _hood(body), collar, _drawstrings(body)])
@@ -802,10 +830,10 @@ EYELASH_GROUPS = (
 
 SPECS = [
     Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014, bridge=True), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
-    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), sleeve_ease(0.006, 0.012), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
+    Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), cuffed(sleeve_ease(0.006, 0.012), 0.002), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
     Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
-    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), sleeve_ease(0.012, 0.01), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
+    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), cuffed(sleeve_ease(0.012, 0.01), 0.006), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02), fly=True), "canvas", "khaki", 0.002, 35, ("shorts",), fly=True),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal"), fly=True),  # noqa: E501
