@@ -215,3 +215,39 @@ def test_jacket_armhole_stitching_runs_without_a_jog(body, piece, sleeve):
     assert len(np.unique(bins)) > 50  # the line runs the whole way round the top
     jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
     assert jog < 0.01, f"armhole stitching steps {jog * 1000:.0f} mm sideways"
+
+
+def _sampled(panels, marks, every: float = 0.002) -> np.ndarray:
+    """(N, 2) UV points every ``every`` m along marks' segments (or polylines)."""
+    points = []
+    for mark in marks:
+        p = mark.points
+        for s0, s1 in p if p.ndim == 3 else np.stack([p[:-1], p[1:]], 1):
+            n = max(2, int(np.linalg.norm(s1 - s0) / panels.scale / every))
+            points.append(s0 + np.linspace(0, 1, n)[:, None] * (s1 - s0))
+    return np.concatenate(points)
+
+
+@pytest.mark.parametrize("side", [1, -1])
+@pytest.mark.parametrize("seam", ["side", "shoulder"])
+def test_jacket_side_and_shoulder_seams_run_without_a_jog(body, piece, side, seam):
+    """The side seam (hem to armpit) and the shoulder seam (neck to armhole) must each be
+    one smooth line on the jacket: the seam's points within any 5 mm along it (z for the
+    side seam, x out from the neck for the shoulder) lie within 6 mm of each other.
+    Drawn along the faces' staircase they stepped sideways by a face (2-3 cm)."""
+    panels = jacket.JacketPanels(body, piece.mesh)
+    paths = sorted(jacket.seam_paths(panels, side), key=lambda p: p[:, 2].max())
+    path = paths[0] if seam == "side" else paths[1]
+    # Panel-edge seams (segments): the side/shoulder seams' own, not the hem band, yoke
+    # or collar (polylines across the panels) nor the armhole's end under the arm.
+    uv = _sampled(panels, [m for m in _kinds(piece, "seam") if m.points.ndim == 3])
+    where, face = _uv_to_3d(piece.mesh, uv)
+    near = np.linalg.norm(where[:, None] - path[None], axis=2).min(axis=1) < 0.03
+    near &= (face >= 0) & (panels.face_panel[face] < jacket.SLEEVES[0])
+    along = where[:, 2] if seam == "side" else np.abs(where[:, 0])
+    ends = np.sort(path[[0, -1], 2] if seam == "side" else np.abs(path[[0, -1], 0]))
+    near &= (along > ends[0] + 0.03) & (along < ends[1] - 0.04)
+    bins = np.round(along[near] / 0.005).astype(int)
+    assert len(np.unique(bins)) > 0.8 * (ends[1] - ends[0] - 0.07) / 0.005  # all along it
+    jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
+    assert jog < 0.006, f"{seam} seam steps {jog * 1000:.0f} mm sideways"

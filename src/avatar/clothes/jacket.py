@@ -27,7 +27,7 @@ from avatar.clothes import tailoring
 from avatar.clothes.authoring import AuthoringBody, Piece
 from avatar.clothes.tailoring import Panel
 from avatar.looks.tailored import Layout, Mark
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, vertex_normals
 
 PANELS = (*tailoring.TROUSER_PANELS,  # left front, left back, right front, right back
           Panel("left sleeve", 1, False), Panel("right sleeve", -1, False))
@@ -60,7 +60,7 @@ class JacketPanels(tailoring.Panels):
         corners = v[f]
         side = np.where(centre[:, 0] >= 0, 1, -1)
         sleeve = _on_sleeve(body, centre)
-        axis = tailoring.body_axis(body.marks)
+        axis = self.axis = tailoring.body_axis(body.marks)
         back = centre[:, 1] > axis(side, centre[:, 2])[:, 1]
         # Over the shoulders front and back meet along the ridge (the cloth's highest line
         # at each distance out from the neck), not the hips' plane: split there, the
@@ -232,9 +232,16 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
     # staircase where sleeve meets body: that stepped sideways by a face under the arm.
     curves = {k: armhole_curve(panels, k)[0] for k in SLEEVES}
     spans = {k: (float(u[0]), float(u[-1])) for k, u in curves.items() if len(u)}
-    out = topstitched_seams(panels, keep=_drawn_smooth(panels, spans))
+    smooth = _drawn_smooth(panels, spans)
+    out = topstitched_seams(
+        panels, keep=lambda fa, fb: smooth(fa, fb) & ~_front_back(panels, fa, fb))
     for k in SLEEVES:
         out += armhole(panels, k)
+    # The side and shoulder seams likewise: one smooth line on the jacket, drawn on the
+    # front and back charts both (each shows it where its faces are), not the staircase.
+    for side in (1, -1):
+        for path in seam_paths(panels, side):
+            out += _seam_along(panels, smooth_path(path), side)
     for k in BODY:
         hem = float(panels.lo[k, 1])
         band = hem + 0.045  # the hem band's seam
@@ -373,6 +380,129 @@ def _drawn_smooth(panels: JacketPanels, curves: dict):
     return keep
 
 
+def _front_back(panels: JacketPanels, fa: np.ndarray, fb: np.ndarray) -> np.ndarray:
+    """(M,) bool: face pairs across a front/back seam of one side (side, shoulder seams)."""
+    pa, pb = panels.face_panel[fa], panels.face_panel[fb]
+    return (pa < SLEEVES[0]) & (pb < SLEEVES[0]) & (pa // 2 == pb // 2) & (pa != pb)
+
+
+def seam_paths(panels: JacketPanels, side: int) -> list[np.ndarray]:
+    """The (N, 3) vertex paths along which side's front and back panels meet, one per
+    seam (the side seam, the shoulder seam), each ordered from one end to the other."""
+    f = panels.mesh.faces
+    front = 0 if side > 0 else 2
+    a, b = f.reshape(-1), np.roll(f, -1, axis=1).reshape(-1)
+    face = np.repeat(np.arange(len(f)), f.shape[1])
+    mine = np.isin(panels.face_panel[face], (front, front + 1))
+    key = np.minimum(a, b).astype(np.int64) * len(panels.mesh.vertices) + np.maximum(a, b)
+    keys, inverse = np.unique(key[mine], return_inverse=True)
+    both = np.zeros((len(keys), 2), bool)
+    both[inverse, panels.face_panel[face[mine]] - front] = True
+    edges = np.stack(np.divmod(keys[both.all(axis=1)], len(panels.mesh.vertices)), -1)
+    paths, left = [], {tuple(e) for e in edges.tolist()}
+    neighbours: dict[int, list[int]] = {}
+    for i, j in left:
+        neighbours.setdefault(i, []).append(j)
+        neighbours.setdefault(j, []).append(i)
+    seen: set[int] = set()
+    for start in sorted(neighbours, key=lambda v: len(neighbours[v])):  # ends first
+        if start in seen:
+            continue
+        path = [start]
+        seen.add(start)
+        while nxt := [n for n in neighbours[path[-1]] if n not in seen]:
+            path.append(nxt[0])
+            seen.add(nxt[0])
+        if len(path) > 2:
+            paths.append(panels.mesh.vertices[np.array(path)].astype(np.float64))
+    return paths
+
+
+def smooth_path(points: np.ndarray, step: float = 0.004) -> np.ndarray:
+    """(M, 3) the line a staircase vertex path (N, 3) follows, every ``step`` m from one
+    end to the other: its points averaged over SEAM_SMOOTH m along the seam's chord,
+    each weighted by how far it runs along it (a sideways step, a face wide, adds
+    nothing; blurred along the path it still bent the line by a cm)."""
+    run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    fine = np.stack([np.interp(np.arange(0.0, run[-1], 0.001), run, points[:, i])
+                     for i in range(3)], -1)  # fmt: skip
+    chord = (points[-1] - points[0]) / np.linalg.norm(points[-1] - points[0])
+    t = fine @ chord
+    along = np.abs(np.gradient(t)) + 1e-5
+    at = np.linspace(t[0], t[-1], max(int(abs(t[-1] - t[0]) / step), 2))
+    w = np.exp(-0.5 * ((at[:, None] - t[None]) / SEAM_SMOOTH) ** 2) * along[None]
+    return (w @ fine) / w.sum(axis=1, keepdims=True)
+
+
+def _seam_along(panels: JacketPanels, line: np.ndarray, side: int,
+                offset: float = 0.005) -> list[Mark]:  # fmt: skip
+    """A pressed-open seam along a 3D line (M, 3) between side's front and back: the seam,
+    its allowance's ridges and topstitching ``offset`` m either side, each drawn in both
+    charts where that chart's faces are."""
+    from scipy.spatial import cKDTree
+
+    v = panels.mesh.vertices.astype(np.float64)
+    _, nearest = cKDTree(v).query(line)
+    normal = vertex_normals(v, panels.mesh.faces)[nearest]
+    across = np.cross(np.gradient(line, axis=0), normal)
+    across /= np.maximum(np.linalg.norm(across, axis=1, keepdims=True), 1e-12)
+    out = []
+    for kind, d, width, strength in (("seam", 0.0, 0.002, 1.0),
+                                     ("fold", 0.5, 0.0025, ALLOWANCE),
+                                     ("fold", -0.5, 0.0025, ALLOWANCE),
+                                     ("stitch", 1.0, 0.0008, 1.0),
+                                     ("stitch", -1.0, 0.0008, 1.0)):  # fmt: skip
+        points = line + across * d * offset
+        for k in (0, 1) if side > 0 else (2, 3):
+            segments = _in_chart_segments(panels, k, points, side)
+            if len(segments):
+                out.append(Mark(kind, segments, width, strength))
+    return out
+
+
+def _in_chart_segments(panels: JacketPanels, k: int, points: np.ndarray,
+                       side: int) -> np.ndarray:  # fmt: skip
+    """(S, 2, 2) uv segments of a 3D polyline (M, 3) mapped into body chart k through
+    the faces it lies on (``_chart_points``): those with an end on one of chart k's faces
+    (the other end mapped through the same face's plane, a few mm past the edge)."""
+    uz, inside = _chart_points(panels, k, points)
+    pick = np.flatnonzero(inside[:-1] | inside[1:])
+    uv = panels.uv(k, uz)
+    return np.stack([uv[pick], uv[pick + 1]], 1)
+
+
+def _chart_points(panels: JacketPanels, k: int, points: np.ndarray, near: int = 8):
+    """((M, 2) uz, (M,) bool inside) of 3D points near the jacket in chart k: each point
+    dropped onto the plane of the nearest of chart k's triangles it falls in (or nearly:
+    the one whose barycentric weights are least negative) and its weights applied to the
+    corners' chart coordinates. Not ``panel_coordinates`` of the point: a line smoothed
+    in 3D leaves the surface by a few mm (the waist curves in), which moved it off both
+    charts."""
+    from scipy.spatial import cKDTree
+
+    v = panels.mesh.vertices.astype(np.float64)
+    mine = np.flatnonzero(panels.face_panel == k)
+    quads, uz = panels.mesh.faces[mine], panels.corner_uz[mine]
+    tri, tri_uz = (np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]) for q in (quads, uz))
+    corner = v[tri]  # (T, 3, 3)
+    _, cand = cKDTree(corner.mean(axis=1)).query(points, min(near, len(tri)))
+    a = corner[cand, 0]
+    e1, e2 = corner[cand, 1] - a, corner[cand, 2] - a
+    d = points[:, None] - a  # (M, K, 3)
+    g11, g12, g22 = (np.einsum("mkd,mkd->mk", x, y) for x, y in ((e1, e1), (e1, e2), (e2, e2)))
+    b1, b2 = np.einsum("mkd,mkd->mk", d, e1), np.einsum("mkd,mkd->mk", d, e2)
+    det = np.maximum(g11 * g22 - g12**2, 1e-18)
+    s, t = (g22 * b1 - g12 * b2) / det, (g11 * b2 - g12 * b1) / det
+    weight = np.stack([1 - s - t, s, t], -1)  # (M, K, 3)
+    gap = np.linalg.norm(d - s[..., None] * e1 - t[..., None] * e2, axis=-1)
+    score = weight.min(axis=-1) - (gap > 0.01)  # off the plane by a cm: another layer
+    best = np.argmax(score, axis=1)
+    rows = np.arange(len(points))
+    out = np.einsum("mc,mcd->md", weight[rows, best], tri_uz[cand[rows, best]])
+    return out, score[rows, best] >= 0
+
+
+SEAM_SMOOTH = 0.02  # m along a side or shoulder seam its staircase is blurred over
 ARMHOLE_SMOOTH = 0.02  # m (along u) the armhole's curve is blurred over: a face and a bit
 
 
@@ -418,4 +548,5 @@ def tailored(body: AuthoringBody, piece: Piece) -> Piece:
 
 
 __all__ = ["PANELS", "JacketPanels", "armhole", "armhole_boundary", "armhole_curve",
-           "jacket_marks", "tailored", "topstitched_seams"]  # fmt: skip
+           "jacket_marks", "seam_paths", "smooth_path", "tailored",
+           "topstitched_seams"]  # fmt: skip
