@@ -234,7 +234,7 @@ def test_jacket_side_and_shoulder_seams_run_without_a_jog(body, piece, side, sea
     """The side seam (hem to armpit) and the shoulder seam (neck to armhole) must each be
     one smooth line on the jacket: the seam's points within any 5 mm along it (z for the
     side seam, x out from the neck for the shoulder) lie within 6 mm of each other.
-    Drawn along the faces' staircase they stepped sideways by a face (2-3 cm)."""
+    Drawn along the faces' staircase they stepped sideways by a face (31-37 mm; 4 mm now)."""
     panels = jacket.JacketPanels(body, piece.mesh)
     paths = sorted(jacket.seam_paths(panels, side), key=lambda p: p[:, 2].max())
     path = paths[0] if seam == "side" else paths[1]
@@ -251,3 +251,32 @@ def test_jacket_side_and_shoulder_seams_run_without_a_jog(body, piece, side, sea
     assert len(np.unique(bins)) > 0.8 * (ends[1] - ends[0] - 0.07) / 0.005  # all along it
     jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
     assert jog < 0.006, f"{seam} seam steps {jog * 1000:.0f} mm sideways"
+
+
+@pytest.mark.parametrize("sleeve", jacket.SLEEVES)
+def test_jacket_armhole_seam_is_one_smooth_loop(body, piece, sleeve):
+    """The armhole seam must run as one smooth closed line round the arm, under it too:
+    its points within any 5 mm of arc round the armhole (the angle in the armhole's plane)
+    lie within 6 mm of each other, most of the way round (not where the shoulder and
+    side seams and the back yoke meet it). Drawn in the sleeve's chart alone it stopped
+    8 cm short each side under the arm, the staircase of face edges drawn there, a step
+    at each end (11 mm; 4-5 mm now)."""
+    panels = jacket.JacketPanels(body, piece.mesh)
+    ring = jacket.armhole_ring(panels, sleeve)
+    centre = ring.mean(axis=0)
+    basis = np.linalg.svd(ring - centre, full_matrices=False)[2][:2]
+    radius = float(np.linalg.norm((ring - centre) @ basis.T, axis=1).mean())
+    uv = _sampled(panels, _kinds(piece, "seam"))
+    where, face = _uv_to_3d(piece.mesh, uv)
+    near = np.linalg.norm(where[:, None] - ring[None], axis=2).min(axis=1) < 0.02
+    near &= (face >= 0) & (np.abs(where[:, 2] - (body.marks.chest_z + 0.1)) > 0.025)  # yoke
+    side = jacket.PANELS[sleeve].side
+    meeting = np.array([p[np.argmin(np.linalg.norm(p - centre, axis=1))]
+                        for p in jacket.seam_paths(panels, side)])  # fmt: skip
+    near &= np.linalg.norm(where[:, None] - meeting[None], axis=2).min(axis=1) > 0.025
+    flat = (where[near] - centre) @ basis.T
+    arc = np.mod(np.arctan2(flat[:, 1], flat[:, 0]), 2 * np.pi) * radius
+    bins = np.round(arc / 0.005).astype(int)
+    assert len(np.unique(bins)) > 0.6 * 2 * np.pi * radius / 0.005  # all the way round
+    jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
+    assert jog < 0.006, f"armhole seam steps {jog * 1000:.0f} mm sideways"
