@@ -280,3 +280,16 @@ def test_jacket_armhole_seam_is_one_smooth_loop(body, piece, sleeve):
     assert len(np.unique(bins)) > 0.6 * 2 * np.pi * radius / 0.005  # all the way round
     jog = max(float(np.ptp(where[near][bins == b], axis=0).max()) for b in np.unique(bins))
     assert jog < 0.006, f"armhole seam steps {jog * 1000:.0f} mm sideways"
+
+
+def test_jacket_side_and_shoulder_seams_reach_their_ends(body, piece):
+    """The smoothed side and shoulder seams must run all the way: each line's ends within
+    5 mm (along it) of where its seam meets the hem, armhole or collar (averaged, not
+    fitted, near an end the line stopped 1.4 cm short of the armhole: a gap, a bracket)."""
+    panels = jacket.JacketPanels(body, piece.mesh)
+    for side in (1, -1):
+        for path in jacket.seam_paths(panels, side):
+            line = jacket.smooth_path(path)
+            chord = (path[-1] - path[0]) / np.linalg.norm(path[-1] - path[0])
+            short = np.abs((line[[0, -1]] - path[[0, -1]]) @ chord).max()  # along the seam
+            assert short < 0.005, f"a seam stops {short * 1000:.0f} mm short of its end"

@@ -335,7 +335,7 @@ def _meeting_paths(panels: JacketPanels, one: tuple, other: tuple) -> list[np.nd
 
 def smooth_path(points: np.ndarray, step: float = 0.004) -> np.ndarray:
     """(M, 3) the line a staircase vertex path (N, 3) follows, every ``step`` m from one
-    end to the other: its points averaged over SEAM_SMOOTH m along the seam's chord,
+    end to the other: a line fitted to its points over SEAM_SMOOTH m along the seam's chord,
     each weighted by how far it runs along it (a sideways step, a face wide, adds
     nothing; blurred along the path it still bent the line by a cm)."""
     run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
@@ -345,8 +345,13 @@ def smooth_path(points: np.ndarray, step: float = 0.004) -> np.ndarray:
     t = fine @ chord
     along = np.abs(np.gradient(t)) + 1e-5
     at = np.linspace(t[0], t[-1], max(int(abs(t[-1] - t[0]) / step), 2))
-    w = np.exp(-0.5 * ((at[:, None] - t[None]) / SEAM_SMOOTH) ** 2) * along[None]
-    return (w @ fine) / w.sum(axis=1, keepdims=True)
+    apart = t[None] - at[:, None]
+    w = np.exp(-0.5 * (apart / SEAM_SMOOTH) ** 2) * along[None]
+    # A line fitted locally, not a mean: a mean's window is one-sided at an end and
+    # pulled the seam's ends 1.5 cm short of the armhole, hem and collar.
+    s0, s1, s2 = w.sum(axis=1), (w * apart).sum(axis=1), (w * apart**2).sum(axis=1)
+    mean, slope = w @ fine, (w * apart) @ fine
+    return (s2[:, None] * mean - s1[:, None] * slope) / (s0 * s2 - s1**2)[:, None]
 
 
 def smooth_loop(points: np.ndarray, step: float = 0.004) -> np.ndarray:
