@@ -27,7 +27,7 @@ from avatar.clothes import tailoring
 from avatar.clothes.authoring import AuthoringBody, Piece
 from avatar.clothes.tailoring import Panel
 from avatar.looks.tailored import Layout, Mark
-from avatar.mesh import Mesh
+from avatar.mesh import Mesh, vertex_normals
 
 PANELS = (*tailoring.TROUSER_PANELS,  # left front, left back, right front, right back
           Panel("left sleeve", 1, False), Panel("right sleeve", -1, False))
@@ -60,7 +60,7 @@ class JacketPanels(tailoring.Panels):
         corners = v[f]
         side = np.where(centre[:, 0] >= 0, 1, -1)
         sleeve = _on_sleeve(body, centre)
-        axis = tailoring.body_axis(body.marks)
+        axis = self.axis = tailoring.body_axis(body.marks)
         back = centre[:, 1] > axis(side, centre[:, 2])[:, 1]
         # Over the shoulders front and back meet along the ridge (the cloth's highest line
         # at each distance out from the neck), not the hips' plane: split there, the
@@ -228,13 +228,15 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
     """A zip-front jacket: topstitched side, shoulder, centre-back, armhole and underarm
     seams; a zip down each front's opening; two lower welt pockets and a chest pocket; a
     back yoke; a hem band, cuffs and a collar band, each sewn on and topstitched."""
-    # The armhole is drawn smooth in the sleeve's chart (``armhole``), not along the faces'
-    # staircase where sleeve meets body: that stepped sideways by a face under the arm.
-    curves = {k: armhole_curve(panels, k)[0] for k in SLEEVES}
-    spans = {k: (float(u[0]), float(u[-1])) for k, u in curves.items() if len(u)}
-    out = topstitched_seams(panels, keep=_drawn_smooth(panels, spans))
+    # The armhole, side and shoulder seams are drawn as the smooth lines their faces'
+    # staircase follows (1-4 cm faces: drawn along them they zig-zagged), each in the
+    # charts of both panels it joins (each shows it where its faces are).
+    out = topstitched_seams(panels, keep=lambda fa, fb: ~_drawn_along_lines(panels, fa, fb))
     for k in SLEEVES:
-        out += armhole(panels, k)
+        out += _armhole_along(panels, k, smooth_loop(armhole_ring(panels, k)))
+    for side in (1, -1):
+        for path in seam_paths(panels, side):
+            out += _seam_along(panels, smooth_path(path), side)
     for k in BODY:
         hem = float(panels.lo[k, 1])
         band = hem + 0.045  # the hem band's seam
@@ -279,101 +281,221 @@ def jacket_marks(panels: JacketPanels, marks) -> list[Mark]:
     return out
 
 
-def armhole_boundary(panels: JacketPanels, k: int) -> np.ndarray:
-    """(N, 2) points (u, z) of sleeve k's chart along the edges it shares with the body
-    panels (a staircase of face edges), 10 a face edge."""
+def _drawn_along_lines(panels: JacketPanels, fa: np.ndarray, fb: np.ndarray) -> np.ndarray:
+    """(M,) bool: face pairs across a seam drawn along a smooth line instead: a front/back
+    seam of one side (side, shoulder seams) or the armhole (sleeve and body)."""
+    pa, pb = panels.face_panel[fa], panels.face_panel[fb]
+    body_a, body_b = pa < SLEEVES[0], pb < SLEEVES[0]
+    return (body_a & body_b & (pa // 2 == pb // 2) & (pa != pb)) | (body_a != body_b)
+
+
+def seam_paths(panels: JacketPanels, side: int) -> list[np.ndarray]:
+    """The (N, 3) vertex paths along which side's front and back panels meet, one per
+    seam (the side seam, the shoulder seam), each ordered from one end to the other."""
+    front = 0 if side > 0 else 2
+    return _meeting_paths(panels, (front,), (front + 1,))
+
+
+def armhole_ring(panels: JacketPanels, k: int) -> np.ndarray:
+    """(N, 3) the vertex loop along which sleeve k meets the body panels, in order."""
+    body = (0, 1) if PANELS[k].side > 0 else (2, 3)
+    return max(_meeting_paths(panels, (k,), body), key=len)
+
+
+def _meeting_paths(panels: JacketPanels, one: tuple, other: tuple) -> list[np.ndarray]:
+    """(N, 3) vertex paths along the edges between faces of panels ``one`` and ``other``."""
     f = panels.mesh.faces
-    on_body = np.zeros(len(panels.mesh.vertices), bool)
-    on_body[f[panels.face_panel < SLEEVES[0]].reshape(-1)] = True
+    a, b = f.reshape(-1), np.roll(f, -1, axis=1).reshape(-1)
+    face = np.repeat(np.arange(len(f)), f.shape[1])
+    in_one = np.isin(panels.face_panel[face], one)
+    mine = in_one | np.isin(panels.face_panel[face], other)
+    key = np.minimum(a, b).astype(np.int64) * len(panels.mesh.vertices) + np.maximum(a, b)
+    keys, inverse = np.unique(key[mine], return_inverse=True)
+    both = np.zeros((len(keys), 2), bool)
+    both[inverse, (~in_one[mine]).astype(int)] = True
+    edges = np.stack(np.divmod(keys[both.all(axis=1)], len(panels.mesh.vertices)), -1)
+    paths, left = [], {tuple(e) for e in edges.tolist()}
+    neighbours: dict[int, list[int]] = {}
+    for i, j in left:
+        neighbours.setdefault(i, []).append(j)
+        neighbours.setdefault(j, []).append(i)
+    seen: set[int] = set()
+    for start in sorted(neighbours, key=lambda v: len(neighbours[v])):  # ends first
+        if start in seen:
+            continue
+        path = [start]
+        seen.add(start)
+        while nxt := [n for n in neighbours[path[-1]] if n not in seen]:
+            path.append(nxt[0])
+            seen.add(nxt[0])
+        if len(path) > 2:
+            paths.append(panels.mesh.vertices[np.array(path)].astype(np.float64))
+    return paths
+
+
+def smooth_path(points: np.ndarray, step: float = 0.004) -> np.ndarray:
+    """(M, 3) the line a staircase vertex path (N, 3) follows, every ``step`` m from one
+    end to the other: a line fitted to its points over SEAM_SMOOTH m along the seam's chord,
+    each weighted by how far it runs along it (a sideways step, a face wide, adds
+    nothing; blurred along the path it still bent the line by a cm)."""
+    run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    fine = np.stack([np.interp(np.arange(0.0, run[-1], 0.001), run, points[:, i])
+                     for i in range(3)], -1)  # fmt: skip
+    chord = (points[-1] - points[0]) / np.linalg.norm(points[-1] - points[0])
+    t = fine @ chord
+    along = np.abs(np.gradient(t)) + 1e-5
+    at = np.linspace(t[0], t[-1], max(int(abs(t[-1] - t[0]) / step), 2))
+    apart = t[None] - at[:, None]
+    w = np.exp(-0.5 * (apart / SEAM_SMOOTH) ** 2) * along[None]
+    # A line fitted locally, not a mean: a mean's window is one-sided at an end and
+    # pulled the seam's ends 1.5 cm short of the armhole, hem and collar.
+    s0, s1, s2 = w.sum(axis=1), (w * apart).sum(axis=1), (w * apart**2).sum(axis=1)
+    mean, slope = w @ fine, (w * apart) @ fine
+    return (s2[:, None] * mean - s1[:, None] * slope) / (s0 * s2 - s1**2)[:, None]
+
+
+def smooth_loop(points: np.ndarray, step: float = 0.004) -> np.ndarray:
+    """(M, 3) the closed line a staircase vertex loop (N, 3) follows (its first point
+    repeated last): as ``smooth_path``, averaged over SEAM_SMOOTH m round the loop's
+    angle in its plane, each point weighted by how far it turns it."""
+    closed = np.concatenate([points, points[:1]])
+    run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    fine = np.stack([np.interp(np.arange(0.0, run[-1], 0.001), run, closed[:, i])
+                     for i in range(3)], -1)  # fmt: skip
+    centre = fine.mean(axis=0)
+    basis = np.linalg.svd(fine - centre, full_matrices=False)[2][:2]
+    flat = (fine - centre) @ basis.T
+    angle = np.unwrap(np.arctan2(flat[:, 1], flat[:, 0]))
+    turn = np.abs(np.gradient(angle)) + 1e-5
+    sigma = SEAM_SMOOTH / float(np.linalg.norm(flat, axis=1).mean())
+    at = angle[0] + np.sign(angle[-1] - angle[0]) * np.linspace(0, 2 * np.pi, int(run[-1] / step))
+    apart = np.mod(at[:, None] - angle[None] + np.pi, 2 * np.pi) - np.pi
+    w = np.exp(-0.5 * (apart / sigma) ** 2) * turn[None]
+    return (w @ fine) / w.sum(axis=1, keepdims=True)
+
+
+def _armhole_along(panels: JacketPanels, k: int, line: np.ndarray,
+                   offset: float = 0.005) -> list[Mark]:  # fmt: skip
+    """Sleeve k's armhole seam along a closed 3D line (M, 3), its allowance's ridge and
+    topstitching ``offset`` m towards the sleeve, drawn in the sleeve's chart and the body
+    panels' both (each shows it where its faces are: under the arm the sleeve's chart
+    flares, drawn there alone it had to stop 8 cm short)."""
+    across = _across_seam(panels, line)
+    plane = np.linalg.svd(line - line.mean(axis=0), full_matrices=False)[2][2]
+    towards_arm = plane * np.sign(plane[0] * PANELS[k].side)  # the arm runs out in x
+    across *= np.sign(across @ towards_arm)[:, None]
+    out = []
+    for kind, d, width, strength in (("seam", 0.0, 0.002, 1.0),
+                                     ("fold", 0.5, 0.0025, ALLOWANCE),
+                                     ("stitch", 1.0, 0.0008, 1.0)):  # fmt: skip
+        points = line + across * d * offset
+        for chart in (k, *((0, 1) if PANELS[k].side > 0 else (2, 3))):
+            segments = _in_chart_segments(panels, chart, points)
+            if len(segments):
+                out.append(Mark(kind, segments, width, strength))
+    return out
+
+
+def _across_seam(panels: JacketPanels, line: np.ndarray) -> np.ndarray:
+    """(M, 3) unit directions across a line (M, 3) on the jacket, in its surface."""
+    from scipy.spatial import cKDTree
+
+    v = panels.mesh.vertices.astype(np.float64)
+    _, nearest = cKDTree(v).query(line)
+    normal = vertex_normals(v, panels.mesh.faces)[nearest]
+    across = np.cross(np.gradient(line, axis=0), normal)
+    return across / np.maximum(np.linalg.norm(across, axis=1, keepdims=True), 1e-12)
+
+
+def _seam_along(panels: JacketPanels, line: np.ndarray, side: int,
+                offset: float = 0.005) -> list[Mark]:  # fmt: skip
+    """A pressed-open seam along a 3D line (M, 3) between side's front and back: the seam,
+    its allowance's ridges and topstitching ``offset`` m either side, each drawn in both
+    charts where that chart's faces are."""
+    across = _across_seam(panels, line)
+    out = []
+    for kind, d, width, strength in (("seam", 0.0, 0.002, 1.0),
+                                     ("fold", 0.5, 0.0025, ALLOWANCE),
+                                     ("fold", -0.5, 0.0025, ALLOWANCE),
+                                     ("stitch", 1.0, 0.0008, 1.0),
+                                     ("stitch", -1.0, 0.0008, 1.0)):  # fmt: skip
+        points = line + across * d * offset
+        for k in (0, 1) if side > 0 else (2, 3):
+            segments = _in_chart_segments(panels, k, points)
+            if len(segments):
+                out.append(Mark(kind, segments, width, strength))
+    return out
+
+
+def _in_chart_segments(panels: JacketPanels, k: int, points: np.ndarray) -> np.ndarray:
+    """(S, 2, 2) uv segments of a 3D polyline (M, 3) mapped into chart k through the faces
+    it lies on (``_chart_points``): those with an end on one of chart k's faces (the other
+    end mapped through the same face's plane, a few mm past the edge), less any across a
+    sleeve's cut (its two sides lie a chart apart)."""
+    uz, inside = _chart_points(panels, k, points)
+    step = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    jump = np.linalg.norm(np.diff(uz, axis=0), axis=1) > 2 * step
+    pick = np.flatnonzero((inside[:-1] | inside[1:]) & ~jump)
+    uv = panels.uv(k, uz)
+    return np.stack([uv[pick], uv[pick + 1]], 1)
+
+
+def _chart_points(panels: JacketPanels, k: int, points: np.ndarray, near: int = 8):
+    """((M, 2) uz, (M,) bool inside) of 3D points near the jacket in chart k: each point
+    dropped onto the plane of the nearest of chart k's triangles it falls in (or nearly:
+    the one whose barycentric weights are least negative) and its weights applied to the
+    corners' chart coordinates. Not ``panel_coordinates`` of the point: a line smoothed
+    in 3D leaves the surface by a few mm (the waist curves in), which moved it off both
+    charts."""
+    from scipy.spatial import cKDTree
+
+    v = panels.mesh.vertices.astype(np.float64)
     mine = np.flatnonzero(panels.face_panel == k)
-    corner = on_body[f[mine]]  # (S, C) corners shared with a body face
-    edge = corner & np.roll(corner, -1, axis=1)
-    fi, ci = np.nonzero(edge)
-    p0 = panels.corner_uz[mine[fi], ci]
-    p1 = panels.corner_uz[mine[fi], (ci + 1) % f.shape[1]]
-    t = np.linspace(0.0, 1.0, 10)[:, None, None]
-    return (p0 + t * (p1 - p0)).reshape(-1, 2)
+    quads, uz = panels.mesh.faces[mine], panels.corner_uz[mine]
+    tri, tri_uz = (np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]) for q in (quads, uz))
+    corner = v[tri]  # (T, 3, 3)
+    _, cand = cKDTree(corner.mean(axis=1)).query(points, min(near, len(tri)))
+    a = corner[cand, 0]
+    e1, e2 = corner[cand, 1] - a, corner[cand, 2] - a
+    d = points[:, None] - a  # (M, K, 3)
+    g11, g12, g22 = (np.einsum("mkd,mkd->mk", x, y) for x, y in ((e1, e1), (e1, e2), (e2, e2)))
+    b1, b2 = np.einsum("mkd,mkd->mk", d, e1), np.einsum("mkd,mkd->mk", d, e2)
+    det = np.maximum(g11 * g22 - g12**2, 1e-18)
+    s, t = (g22 * b1 - g12 * b2) / det, (g11 * b2 - g12 * b1) / det
+    weight = np.stack([1 - s - t, s, t], -1)  # (M, K, 3)
+    gap = np.linalg.norm(d - s[..., None] * e1 - t[..., None] * e2, axis=-1)
+    score = weight.min(axis=-1) - (gap > 0.01)  # off the plane by a cm: another layer
+    best = np.argmax(score, axis=1)
+    rows = np.arange(len(points))
+    out = np.einsum("mc,mcd->md", weight[rows, best], tri_uz[cand[rows, best]])
+    inside = score[rows, best] >= 0
+    if k in SLEEVES:  # not where the sleeve's top row squashes the cloth under the arm
+        # (2 cm of it in 2 mm): a line drawn there showed as a smear a face away.
+        fair = _stretch(corner, tri_uz)[cand[rows, best]]
+        inside &= (fair > 0.25) & (fair < 4.0)
+    return out, inside
 
 
-def armhole(panels: JacketPanels, k: int, offset: float = 0.005) -> list[Mark]:
-    """Sleeve k's armhole seam, its allowance's ridge and topstitching ``offset`` m down
-    the sleeve along ``armhole_curve``."""
-    u, z = armhole_curve(panels, k, offset)
-    return [Mark("seam", _line(panels, k, u, z)),
-            Mark("fold", _line(panels, k, u, z - 0.5 * offset), 0.0025, ALLOWANCE),
-            Mark("stitch", _line(panels, k, u, z - offset), 0.0008)]
+def _stretch(corner: np.ndarray, uz: np.ndarray) -> np.ndarray:
+    """(T,) how much each triangle (T, 3, 3 corners; T, 3, 2 chart points) is stretched
+    the most in its chart, as a ratio under 1 (squashed) or over (stretched): the one of
+    its chart map's singular values furthest from 1."""
+    e1, e2 = corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0]
+    x = e1 / np.maximum(np.linalg.norm(e1, axis=1, keepdims=True), 1e-12)
+    y = e2 - np.einsum("td,td->t", e2, x)[:, None] * x
+    y /= np.maximum(np.linalg.norm(y, axis=1, keepdims=True), 1e-12)
+    flat = np.stack([np.stack([np.einsum("td,td->t", e, x), np.einsum("td,td->t", e, y)], -1)
+                     for e in (e1, e2)], -1)  # (T, 2, 2): columns the edges in-plane
+    chart = np.stack([uz[:, 1] - uz[:, 0], uz[:, 2] - uz[:, 0]], -1)
+    det = flat[:, 0, 0] * flat[:, 1, 1] - flat[:, 0, 1] * flat[:, 1, 0]
+    flat_inv = np.stack([np.stack([flat[:, 1, 1], -flat[:, 0, 1]], -1),
+                         np.stack([-flat[:, 1, 0], flat[:, 0, 0]], -1)], -2)
+    jac = chart @ (flat_inv / np.where(np.abs(det) > 1e-12, det, 1e-12)[:, None, None])
+    sv = np.linalg.svd(jac, compute_uv=False)
+    return np.where(sv[:, 1] < 1 / sv[:, 0], sv[:, 1], sv[:, 0])
 
 
-def armhole_curve(panels: JacketPanels, k: int, offset: float = 0.005):
-    """(u (N,), z (N,)) of sleeve k's armhole seam in its chart: one smooth curve round
-    the arm (the stepped edge's lowest point each cm of u, blurred over ARMHOLE_SMOOTH m)
-    just below the stepped edge everywhere. Under the arm the chart's top row flares out
-    (u is the angle times a growing radius) over nothing: the curve stops where the
-    chart under it (down to its stitching, ``offset`` m lower) ends."""
-    from scipy.ndimage import gaussian_filter1d, maximum_filter1d, minimum_filter1d
-
-    uz = armhole_boundary(panels, k)
-    bins = np.round(uz[:, 0] / 0.01).astype(int)
-    u = np.arange(bins.min(), bins.max() + 1) * 0.01
-    lowest = np.full(len(u), np.inf)
-    np.minimum.at(lowest, bins - bins.min(), uz[:, 1])
-    known = np.isfinite(lowest)
-    low = np.interp(u, u[known], lowest[known])
-    # A step's foot reaches a bin or so either side of it: the envelope, then the blur.
-    z = gaussian_filter1d(minimum_filter1d(low, 3, mode="nearest"), ARMHOLE_SMOOTH / 0.01,
-                          mode="nearest")  # fmt: skip
-    # Lowered where a step's foot still pokes under it (locally, so the curve keeps to
-    # the edge elsewhere), then by whatever still does.
-    above = np.zeros(len(u))
-    np.maximum.at(above, bins - bins.min(), np.interp(uz[:, 0], u, z) - uz[:, 1])
-    z = z - gaussian_filter1d(maximum_filter1d(above, 5, mode="nearest"), 1.0, mode="nearest")
-    z = z - max(float((np.interp(uz[:, 0], u, z) - uz[:, 1]).max()), 0.0) - 0.002
-    covered = _in_chart(panels, k, np.stack([u, z], -1)) & _in_chart(
-        panels, k, np.stack([u, z - offset], -1))
-    run = _longest_run(covered)
-    return u[run], z[run]
-
-
-def _in_chart(panels: JacketPanels, k: int, uz: np.ndarray) -> np.ndarray:
-    """(N,) bool: points (N, 2) inside one of chart k's faces (each quad as 2 triangles)."""
-    quads = panels.corner_uz[panels.face_panel == k]
-    tri = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
-    a, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    d = uz[:, None] - a[None]  # (N, T, 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = (d[..., 0] * e2[:, 1] - d[..., 1] * e2[:, 0]) / det
-        t = (e1[:, 0] * d[..., 1] - e1[:, 1] * d[..., 0]) / det
-    return ((s >= 0) & (t >= 0) & (s + t <= 1)).any(axis=1)
-
-
-def _longest_run(mask: np.ndarray) -> slice:
-    """The longest stretch of True in mask (N,)."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    starts, ends = edges[::2], edges[1::2]
-    if not len(starts):
-        return slice(0, 0)
-    i = int(np.argmax(ends - starts))
-    return slice(int(starts[i]), int(ends[i]))
-
-
-def _drawn_smooth(panels: JacketPanels, curves: dict):
-    """``Panels.seams`` keep: every seam but the armhole's edges whose sleeve face lies
-    within u of its smooth curve (``curves``: sleeve -> (u lo, u hi))."""
-    centre_u = panels.corner_uz[:, :, 0].mean(axis=1)
-
-    def keep(fa: np.ndarray, fb: np.ndarray) -> np.ndarray:
-        out = np.ones(len(fa), bool)
-        for k, (lo, hi) in curves.items():
-            for sleeve, other in ((fa, fb), (fb, fa)):
-                mine = (panels.face_panel[sleeve] == k) & (panels.face_panel[other] < SLEEVES[0])
-                out &= ~(mine & (centre_u[sleeve] >= lo) & (centre_u[sleeve] <= hi))
-        return out
-
-    return keep
-
-
-ARMHOLE_SMOOTH = 0.02  # m (along u) the armhole's curve is blurred over: a face and a bit
+SEAM_SMOOTH = 0.02  # m along a seam (side, shoulder, armhole) its staircase is blurred over
 
 
 def _zip(panels: JacketPanels, k: int, bottom: float, top: float) -> list[Mark]:
@@ -417,5 +539,5 @@ def tailored(body: AuthoringBody, piece: Piece) -> Piece:
     return replace(piece, mesh=panels.textured(), layout=layout)
 
 
-__all__ = ["PANELS", "JacketPanels", "armhole", "armhole_boundary", "armhole_curve",
-           "jacket_marks", "tailored", "topstitched_seams"]  # fmt: skip
+__all__ = ["PANELS", "JacketPanels", "armhole_ring", "jacket_marks", "seam_paths",
+           "smooth_loop", "smooth_path", "tailored", "topstitched_seams"]  # fmt: skip
