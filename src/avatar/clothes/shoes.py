@@ -341,23 +341,53 @@ CAP_UV_REACH = 0.1  # m from the toe cap's seam that its row's height spans
 
 
 def _cap_uvs(mesh: Mesh, foot: Foot) -> Mesh:
-    """The toe cap's UVs: u round the foot, v from its seam (its back edge, over the vamp:
-    the open edge above the sole's) towards the tip, so the atlas's stitch rows run
-    parallel to the seam, a few millimetres in front of it."""
-    from avatar.geometry.shell import boundary_edges
-
-    planar = _planar_uvs(mesh, "cap")
-    v = mesh.vertices.astype(np.float64)
-    rim = np.unique(boundary_edges(mesh.faces)[0])
-    seam = rim[v[rim, 2] > foot.ground + OPEN_BOTTOM + 0.004]
+    """The toe cap's UVs: v from its seam (its back edge, over the vamp: the open edge
+    above the sole's) towards the tip, so the atlas's stitch rows run parallel to the seam,
+    a few millimetres in front of it; u along the seam (``_along_the_seam``), so it runs
+    down the cap's side walls where v runs along the foot. (u was the angle round the
+    foot's vertical axis: on the side walls it ran along the foot as v did, the texture's
+    axes 1-20 degrees apart and a texel centimetres tall: the grain and gloss drawn as
+    wavy streaks down the walls.)"""
     from scipy.spatial import cKDTree
 
-    d, _ = cKDTree(v[seam]).query(v[mesh.faces.reshape(-1)])
+    p = mesh.vertices.astype(np.float64)
+    seam = _cap_seam(mesh, foot)
+    d, _ = cKDTree(p[seam]).query(p)
     w = 1 - np.clip(d / CAP_UV_REACH, 0, 1)
     v0, v1 = ROWS["cap"]
-    uvs = planar.uvs.copy()  # type: ignore[union-attr]
-    uvs[:, 1] = v0 + (v1 - v0) * (0.05 + 0.9 * w)
-    return Mesh(mesh.vertices, mesh.faces, uvs, planar.face_uvs)
+    u = _along_the_seam(mesh, seam)
+    uvs = np.stack([0.02 + 0.96 * u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1)
+    return Mesh(mesh.vertices, mesh.faces, uvs.astype(np.float32), mesh.faces.copy())
+
+
+def _cap_seam(mesh: Mesh, foot: Foot) -> np.ndarray:
+    """Vertex indices, in order along it, of the toe cap's seam: its boundary loop less
+    the bottom edge that the sole covers."""
+    loop = _lowest_loop(mesh)  # the cap's one boundary loop
+    high = mesh.vertices[loop, 2] > foot.ground + OPEN_BOTTOM + 0.004
+    start = int(np.argmin(high))  # roll the loop so the seam is one run
+    loop, high = np.roll(loop, -start), np.roll(high, -start)
+    return loop[high]
+
+
+def _along_the_seam(mesh: Mesh, seam: np.ndarray) -> np.ndarray:
+    """(V,) in [0, 1]: how far along the seam (a fraction of its length) each vertex's
+    nearest seam point lies, the seam points within a few SEAM_BLEND m of the nearest
+    weighed in softly, so u stays smooth where two stretches of the seam are about as near.
+    Across the distance to the seam, as a closest point moves along it."""
+    p = mesh.vertices.astype(np.float64)
+    s = p[seam]
+    length = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(s, axis=0), axis=1))])
+    fine = np.linspace(0, length[-1], max(2, int(length[-1] / 0.0005)))  # every 0.5 mm
+    points = np.stack([np.interp(fine, length, s[:, k]) for k in range(3)], -1)
+    d = np.linalg.norm(p[:, None] - points[None], axis=-1)  # (V, seam points)
+    weight = np.exp(-(d - d.min(axis=1, keepdims=True)) / SEAM_BLEND)
+    return (weight @ (fine / fine[-1])) / weight.sum(axis=1)
+
+
+# m: how much farther than the nearest a seam point may lie and still count (at 6-25 mm
+# the stretches of seam behind the nose blurred into one another: u crowded into folds).
+SEAM_BLEND = 0.003
 
 
 def cap_stitch_v(mm: float) -> float:
