@@ -1368,10 +1368,10 @@ def _bumped(normal: np.ndarray, height: np.ndarray, slope: float,
 
 # How much taller than wide a grain cell is in each row's texels, so that it is round on
 # the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
-# (~0.33 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm),
+# (~0.33 mm), the toe cap's v away from its seam (~0.57 mm) and its u along it (~0.14 mm),
 # the vamp's v along the foot (~0.8 mm) and its u round it (~0.13 mm). Square in texels,
 # the pebble was streaked round the quarters and along the cap.
-GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.4}
+GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.25}
 KNIT_STRETCH = {"vamp": 0.16}  # a sneaker's mesh cells, the same way
 
 
