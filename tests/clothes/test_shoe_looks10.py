@@ -204,15 +204,19 @@ def _texture_axes(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def test_toe_caps_texture_lies_square_on_its_side_walls(body, foot):
     """On the toe cap's side walls (faces within 60 degrees of upright, behind the nose) a
-    texel covers at most 1.5 mm of leather along u and 1.5 along v, and the texture's two
-    axes stand 25 degrees or more apart (60 for half the faces). With u the angle round
+    texel covers at most 3 mm of leather along u (1 for all but one in twenty) and 1.5 along
+    v, and the texture's two axes stand 25 degrees or more apart (60 for half the faces)
+    (the grain's cells are drawn ``GRAIN_STRETCH`` wider in u texels). With u the angle round
     the foot's vertical axis and v the distance from the seam, both ran along the foot
-    there: axes 0.3 degrees apart (22 for half), a texel up to 79 mm tall along u (1.2 for
-    half), so the grain and gloss were drawn as wavy streaks down the walls."""
+    there: axes 0.3 degrees apart (22 for half), a texel up to 79 mm tall along u (6.5 for
+    one in twenty), up to 10 along v, so the grain and gloss were drawn as wavy streaks
+    down the walls."""
     axes, facing, middle = _texture_axes(shoes.toe_cap(body, foot).mesh)
     wall = (np.abs(facing[:, 2]) < 0.5) & (foot.along(middle) < 1.0)
     along_u, along_v = (np.linalg.norm(axes[wall, :, k], axis=1) for k in (0, 1))
     cos = np.abs(np.einsum("nd,nd->n", axes[wall, :, 0], axes[wall, :, 1])) / along_u / along_v
     apart = np.degrees(np.arccos(np.clip(cos, 0, 1)))
-    assert along_u.max() < 1.5 and along_v.max() < 1.5, (along_u.max(), along_v.max())
+    assert along_u.max() < 3 and np.percentile(along_u, 95) < 1, (along_u.max(),
+                                                                 np.percentile(along_u, 95))
+    assert along_v.max() < 1.5, along_v.max()
     assert apart.min() > 25 and np.median(apart) > 60, (apart.min(), np.median(apart))
