@@ -1,6 +1,6 @@
 """Render the toe cap's side wall close up (docs/images/looks10_capwall_*.png): the man's
-left shoe and the woman's left boot from their outer side, aimed with ``render_looks9``'s
-``--at`` (one shoe close).
+left shoe and sneaker and the woman's left boot from their outer side, aimed with
+``render_looks9``'s ``--at`` (one shoe close).
 
     python bench/render_looks10_capwall.py OUT_DIR [NAME ...]   # all of SHOTS if no NAME
     python bench/render_looks9.py sheet BEFORE_DIR AFTER_DIR OUT.png capwall_s9-shoes_side ...
@@ -21,6 +21,8 @@ SHOTS = {  # name: render_looks9 arguments (the file is closeup_capwall_SET_VIEW
             *SMALL],  # fmt: skip
     "boot": ["s9-boots", "--views", "side", "--at", "0.175,-0.15,0.11,0.03", "--name",
              "capwall", *SMALL],  # fmt: skip
+    "sneaker": ["s9-sneakers", "--views", "side", "--at", "0.13,-0.08,0.1,0.03", "--name",
+                "capwall", *SMALL],  # fmt: skip
 }
 
 

@@ -1376,7 +1376,7 @@ def _bumped(normal: np.ndarray, height: np.ndarray, slope: float,
 # the vamp's v along the foot (~0.8 mm) and its u round it (~0.13 mm). Square in texels,
 # the pebble was streaked round the quarters and along the cap.
 GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.5}
-KNIT_STRETCH = {"vamp": 0.16}  # a sneaker's mesh cells, the same way
+KNIT_STRETCH = {"vamp": 0.16, "cap": 0.5}  # a sneaker's mesh cells, the same way
 
 
 def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
