@@ -183,3 +183,40 @@ def test_toe_caps_fitted_on_other_feet_are_as_smooth_as_made(who):
     inner, _ = _cap_turns(who)
     assert np.percentile(inner, 95) < 16.5 and inner.max() < 35, (np.percentile(inner, 95),
                                                                 inner.max())  # fmt: skip
+
+
+
+def _texture_axes(mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Of each triangle of ``mesh``'s faces: (T, 3, 2) the surface one texel (1/1024 of
+    the atlas) covers along u and along v, in mm; (T, 3) its facing; (T, 3) its middle."""
+    f, c = mesh.faces, mesh.face_uvs
+    tri = np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
+    corners = np.concatenate([c[:, [0, 1, 2]], c[:, [0, 2, 3]]])
+    real = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
+    p = mesh.vertices[tri[real]].astype(np.float64)
+    uv = mesh.uvs[corners[real]].astype(np.float64) * 1024
+    edges = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]], -1)  # (T, 3, 2)
+    steps = np.stack([uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]], -1)  # (T, 2, 2)
+    facing = np.cross(edges[..., 0], edges[..., 1])
+    facing /= np.linalg.norm(facing, axis=1)[:, None]
+    return edges @ np.linalg.inv(steps) * 1000, facing, p.mean(axis=1)
+
+
+def test_toe_caps_texture_lies_square_on_its_side_walls(body, foot):
+    """On the toe cap's side walls (faces within 60 degrees of upright, behind the nose) a
+    texel covers at most 3 mm of leather along u (1 for all but one in twenty) and 1.5 along
+    v, and the texture's two axes stand 25 degrees or more apart (60 for half the faces)
+    (the grain's cells are drawn ``GRAIN_STRETCH`` wider in u texels). With u the angle round
+    the foot's vertical axis and v the distance from the seam, both ran along the foot
+    there: axes 0.3 degrees apart (22 for half), a texel up to 79 mm tall along u (6.5 for
+    one in twenty), up to 10 along v, so the grain and gloss were drawn as wavy streaks
+    down the walls."""
+    axes, facing, middle = _texture_axes(shoes.toe_cap(body, foot).mesh)
+    wall = (np.abs(facing[:, 2]) < 0.5) & (foot.along(middle) < 1.0)
+    along_u, along_v = (np.linalg.norm(axes[wall, :, k], axis=1) for k in (0, 1))
+    cos = np.abs(np.einsum("nd,nd->n", axes[wall, :, 0], axes[wall, :, 1])) / along_u / along_v
+    apart = np.degrees(np.arccos(np.clip(cos, 0, 1)))
+    assert along_u.max() < 3 and np.percentile(along_u, 95) < 1, (along_u.max(),
+                                                                 np.percentile(along_u, 95))
+    assert along_v.max() < 1.5, along_v.max()
+    assert apart.min() > 25 and np.median(apart) > 60, (apart.min(), np.median(apart))

@@ -338,26 +338,60 @@ def _skived(mesh: Mesh, foot: Foot) -> Mesh:
 
 
 CAP_UV_REACH = 0.1  # m from the toe cap's seam that its row's height spans
+# The width of the atlas the cap's seam spans: across all of it (0.96) a texel was 0.14 mm
+# along the seam against 0.57 across it, the stitches' 6-texel dashes beads under a
+# millimetre long; across half, 0.28 mm and dashes of 1.7 mm, as on the quarters.
+CAP_U_SPAN = 0.48
 
 
 def _cap_uvs(mesh: Mesh, foot: Foot) -> Mesh:
-    """The toe cap's UVs: u round the foot, v from its seam (its back edge, over the vamp:
-    the open edge above the sole's) towards the tip, so the atlas's stitch rows run
-    parallel to the seam, a few millimetres in front of it."""
-    from avatar.geometry.shell import boundary_edges
-
-    planar = _planar_uvs(mesh, "cap")
-    v = mesh.vertices.astype(np.float64)
-    rim = np.unique(boundary_edges(mesh.faces)[0])
-    seam = rim[v[rim, 2] > foot.ground + OPEN_BOTTOM + 0.004]
+    """The toe cap's UVs: v from its seam (its back edge, over the vamp: the open edge
+    above the sole's) towards the tip, so the atlas's stitch rows run parallel to the seam,
+    a few millimetres in front of it; u along the seam (``_along_the_seam``), so it runs
+    down the cap's side walls where v runs along the foot. (u was the angle round the
+    foot's vertical axis: on the side walls it ran along the foot as v did, the texture's
+    axes 1-20 degrees apart and a texel centimetres tall: the grain and gloss drawn as
+    wavy streaks down the walls.)"""
     from scipy.spatial import cKDTree
 
-    d, _ = cKDTree(v[seam]).query(v[mesh.faces.reshape(-1)])
+    p = mesh.vertices.astype(np.float64)
+    seam = _cap_seam(mesh, foot)
+    d, _ = cKDTree(p[seam]).query(p)
     w = 1 - np.clip(d / CAP_UV_REACH, 0, 1)
     v0, v1 = ROWS["cap"]
-    uvs = planar.uvs.copy()  # type: ignore[union-attr]
-    uvs[:, 1] = v0 + (v1 - v0) * (0.05 + 0.9 * w)
-    return Mesh(mesh.vertices, mesh.faces, uvs, planar.face_uvs)
+    u = _along_the_seam(mesh, seam)
+    uvs = np.stack([0.02 + CAP_U_SPAN * u, v0 + (v1 - v0) * (0.05 + 0.9 * w)], -1)
+    return Mesh(mesh.vertices, mesh.faces, uvs.astype(np.float32), mesh.faces.copy())
+
+
+def _cap_seam(mesh: Mesh, foot: Foot) -> np.ndarray:
+    """Vertex indices, in order along it, of the toe cap's seam: its boundary loop less
+    the bottom edge that the sole covers."""
+    loop = _lowest_loop(mesh)  # the cap's one boundary loop
+    high = mesh.vertices[loop, 2] > foot.ground + OPEN_BOTTOM + 0.004
+    start = int(np.argmin(high))  # roll the loop so the seam is one run
+    loop, high = np.roll(loop, -start), np.roll(high, -start)
+    return loop[high]
+
+
+def _along_the_seam(mesh: Mesh, seam: np.ndarray) -> np.ndarray:
+    """(V,) in [0, 1]: how far along the seam (a fraction of its length) each vertex's
+    nearest seam point lies, the seam points within a few SEAM_BLEND m of the nearest
+    weighed in softly, so u stays smooth where two stretches of the seam are about as near.
+    Across the distance to the seam, as a closest point moves along it."""
+    p = mesh.vertices.astype(np.float64)
+    s = p[seam]
+    length = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(s, axis=0), axis=1))])
+    fine = np.linspace(0, length[-1], max(2, int(length[-1] / 0.0005)))  # every 0.5 mm
+    points = np.stack([np.interp(fine, length, s[:, k]) for k in range(3)], -1)
+    d = np.linalg.norm(p[:, None] - points[None], axis=-1)  # (V, seam points)
+    weight = np.exp(-(d - d.min(axis=1, keepdims=True)) / SEAM_BLEND)
+    return (weight @ (fine / fine[-1])) / weight.sum(axis=1)
+
+
+# m: how much farther than the nearest a seam point may lie and still count (at 6-25 mm
+# the stretches of seam behind the nose blurred into one another: u crowded into folds).
+SEAM_BLEND = 0.003
 
 
 def cap_stitch_v(mm: float) -> float:
@@ -1338,11 +1372,11 @@ def _bumped(normal: np.ndarray, height: np.ndarray, slope: float,
 
 # How much taller than wide a grain cell is in each row's texels, so that it is round on
 # the shoe: the upper's u runs round the foot (~0.6 mm a texel at 1024) and its v up it
-# (~0.33 mm), the toe cap's v away from its seam (~0.55 mm) and its u round it (~0.2 mm),
+# (~0.33 mm), the toe cap's v away from its seam (~0.57 mm) and its u along it (~0.28 mm),
 # the vamp's v along the foot (~0.8 mm) and its u round it (~0.13 mm). Square in texels,
 # the pebble was streaked round the quarters and along the cap.
-GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.4}
-KNIT_STRETCH = {"vamp": 0.16}  # a sneaker's mesh cells, the same way
+GRAIN_STRETCH = {"upper": 1.8, "vamp": 0.16, "cap": 0.5}
+KNIT_STRETCH = {"vamp": 0.16, "cap": 0.5}  # a sneaker's mesh cells, the same way
 
 
 def _grained(m: Material, span: tuple[float, float], size: int, stretch: float = 1.0) -> None:
