@@ -38,7 +38,7 @@ GARMENT2_DX="${AVATAR_UI_GARMENT2_DX:-146}"
 GARMENT2_DY="${AVATAR_UI_GARMENT2_DY:-420}"
 DRESS_HEADER_DY="${AVATAR_UI_DRESS_HEADER_DY:-43}"  # click: fold the Dress panel
 APPLY_DX="${AVATAR_UI_APPLY_DX:-102}"       # Motion > Apply, with Body and Dress folded
-APPLY_DY="${AVATAR_UI_APPLY_DY:-183}"
+APPLY_DY="${AVATAR_UI_APPLY_DY:-209}"  # below Resample | FPS and In place
 
 cleanup() {
   [[ -n "${BLENDER_PID:-}" ]] && kill "$BLENDER_PID" 2>/dev/null || true
