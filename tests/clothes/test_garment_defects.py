@@ -16,7 +16,8 @@ WOMAN = {"gender": 0.0, "age": 0.5}
 
 
 def _mid_stride(human: Human, frame: int = 6):
-    """(world (J, 4, 4), skinning matrices (J, 4, 4)) ``frame`` of 24 into the walk."""
+    """(world (J, 4, 4), skinning matrices (J, 4, 4)) ``frame`` of 24 into the walk (the
+    built-in walk, one second at 24 fps)."""
     walk = human.walk(seconds=1.0, fps=24)
     world = kinematics.forward(human.skeleton, walk.rotations[frame:frame + 1],
                                walk.translations[frame:frame + 1])  # fmt: skip
@@ -194,12 +195,9 @@ def _fly_turns(human: Human, frames=range(2, 12, 2)) -> np.ndarray:
     first, second = face_pairs(faces)
     first, second = first[fly[first] & fly[second]], second[fly[first] & fly[second]]
     at_rest = angles(n0)
-    walk = human.walk(seconds=1.0, fps=24)
     out = []
     for frame in frames:
-        world = kinematics.forward(human.skeleton, walk.rotations[frame:frame + 1],
-                                   walk.translations[frame:frame + 1])  # fmt: skip
-        matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
+        _, matrices = _mid_stride(human, frame)
         body = skinning.linear_blend(human.vertices, human.weights, matrices)
         posed = human.outfit.frame(body, matrices, exact=True)[0][:count].astype(np.float64)
         out.append((angles(normals(posed)) - at_rest).max())
@@ -671,12 +669,9 @@ def _outer_surface_clearance(human: Human, frames, keep=None) -> list[float]:
     a, b = np.meshgrid(t, t)
     inside = a + b <= 1
     a, b = a[inside], b[inside]
-    walk = human.walk(seconds=1.0, fps=24)
     out = []
     for frame in frames:
-        world = kinematics.forward(human.skeleton, walk.rotations[frame:frame + 1],
-                                   walk.translations[frame:frame + 1])  # fmt: skip
-        matrices = kinematics.skinning_matrices(human.skeleton, world)[0]
+        _, matrices = _mid_stride(human, frame)
         body = skinning.linear_blend(human.vertices, human.weights, matrices)
         corners = human.outfit.frame(body, matrices, exact=True)[0].astype(np.float64)[faces]
         least = np.inf
