@@ -8,12 +8,13 @@
    goal > 60 frames/s. Anchor: skinning the body alone. Then every 10th frame with
    ``exact=True`` (what exports bake), against the real-time path.
 3. Penetration: random bodies (all ages, both sexes, extreme weights) x every built-in
-   garment (as four layered outfits) and, when the test fixtures are present, the MakeHuman
-   fixture garments, in rest pose, over the walk and (every 10th body, when the fixtures are
-   present) CMU's forward jumps, every ``--step``-th (``--jump-step``-th) frame at 30 fps;
-   ``--shard K/N`` runs every Nth body from K, so N processes share the work. Reports the deepest
-   garment vertex inside the body (goal: <= 1 mm), confirmed by the winding number, split
-   into free and pinched (where skinning pushed one body part into another; see ``Worst``).
+   item (garments, hair, facial hair, brows, lashes; as seven layered outfits) and, when
+   the test fixtures are present, the MakeHuman fixture garments, in rest pose, over the
+   walk and (every 10th body, when the fixtures are present) CMU's forward jumps, every
+   ``--step``-th (``--jump-step``-th) frame at 30 fps; ``--shard K/N`` runs every Nth body
+   from K, so N processes share the work. Reports the deepest garment vertex inside the
+   body (goal: <= 1 mm), confirmed by the winding number, split into free and pinched
+   (where skinning pushed one body part into another; see ``Worst``).
 """
 
 from __future__ import annotations
@@ -33,7 +34,11 @@ from avatar.rig import kinematics, skinning
 OUTFITS = [("tshirt", "jeans", "socks", "shoes", "cap"),
            ("longsleeve", "hoodie", "trousers", "hair-long"),
            ("tanktop", "jacket", "shorts", "leggings", "hair-ponytail"),
-           ("swimsuit", "skirt", "dress", "hair-short")]  # fmt: skip
+           ("swimsuit", "skirt", "dress", "hair-short"),
+           ("tshirt", "cardigan", "sweatpants", "sneakers", "hair-bob", "beard-short"),
+           ("longsleeve", "jeans", "socks", "boots", "hair-bun", "moustache"),
+           ("tanktop", "trousers", "shoes-black", "hair-buzz", "stubble", "eyebrows-black",
+            "eyelashes")]  # fmt: skip
 FOUR = ("tshirt", "jeans", "shoes", "hair-short")
 JUMP = Path(__file__).resolve().parents[2] / "shared/fixtures/bvh/cmu_motionbuilder"
 

@@ -277,7 +277,12 @@ def _frame_weights(garment: Garment, w: SkinWeights) -> SkinWeights:
     where a skirt's weights ramp (``weights.swing``): there up to 8 bones each fade in and
     out smoothly, and a cut to 4 dropped a bone's last few percent between two vertices;
     and over a bridge across the fly (``weights.shared_across``: both legs' thighs, the
-    spine and pelvis, up to 21% of a vertex's weight past the 4th, dropped unevenly)."""
+    spine and pelvis, up to 21% of a vertex's weight past the 4th, dropped unevenly).
+    Items drawn on the skin with no push-out (stubble, brows, lashes: ``collide`` False)
+    keep all theirs: nothing holds them out of the skin, and cut to 4 the stubble sank
+    2-3 mm into the corners of the mouth with the neck bent (the face has many bones)."""
+    if not garment.collide:
+        return w
     limited = w.limit(FRAME_INFLUENCES)
     if (garment.swing_below is None and garment.fly_share is None) or limited is w:
         return limited
