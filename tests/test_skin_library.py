@@ -29,7 +29,8 @@ def test_textured_skins_are_listed_with_thumbnails_and_the_rest_left_out(tmp_pat
     _skin(data / "clothes" / "shirt", "shirt")  # a garment's material, not a skin
     skins = list_skins([data, data / "skins"])  # each found once
     assert [(s.name, s.path) for s in skins] == [("old", str(old)), ("young", str(young))]
-    assert skins[1].thumbnail == str(young.with_suffix(".thumb")) and skins[0].thumbnail is None
+    assert skins[1].thumbnail == str(young.with_suffix(".thumb"))
+    assert skins[0].thumbnail == str(old.parent / "old_diffuse.png")  # no picture: its texture
 
 
 def test_a_clothes_folder_finds_its_sibling_skins(tmp_path):

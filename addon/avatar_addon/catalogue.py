@@ -60,13 +60,13 @@ def garments() -> list[tuple[str, str, str, str]]:
 
 @lru_cache(maxsize=1)
 def skins() -> tuple[tuple[str, str, str], ...]:
-    """(name, .mhmat path, thumbnail path or "") of every textured MakeHuman/MPFB skin in
+    """(name, .mhmat path, picture path) of every textured MakeHuman/MPFB skin in
     the user's asset folders (``looks.skin_library``); ``refresh`` reads them again."""
     try:
         from avatar.clothes.library import user_folders
         from avatar.looks.skin_library import list_skins
 
-        return tuple((s.name, s.path, s.thumbnail or "") for s in list_skins(user_folders()))
+        return tuple((s.name, s.path, s.thumbnail) for s in list_skins(user_folders()))
     except Exception as exc:  # noqa: BLE001 - a panel must draw even without assets
         log.warning("Avatar: no skins listed (%s)", exc)
         return ()

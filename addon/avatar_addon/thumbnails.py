@@ -87,7 +87,8 @@ def icon(entry: str, thumbnail: str) -> int:
 
 
 def skin_icon(path: str, thumbnail: str) -> int:
-    """The preview icon id of a skin's own ``.thumb`` (0 when it cannot be read)."""
+    """The preview icon id of a skin's picture (its ``.thumb``, else its texture; 0 when it
+    cannot be read)."""
     previews = _SKINS.get()
     if path not in previews:
         if not os.path.isfile(thumbnail):

@@ -136,13 +136,14 @@ def set_looks(obj: bpy.types.Object, **looks: str | None) -> None:
 
 def _check_skin(human: Human) -> None:
     """A skin the recipe names must load with its texture (``Human.material`` would fall
-    back to Avatar's skin, silently, where the user asked for this one)."""
-    from avatar.clothes.asset import material_from_file
+    back to Avatar's skin, silently, where the user asked for this one). Only the file and
+    its texture's name are read: the texture itself is decoded once, for the material."""
+    from avatar.io import mhmat
 
     path = human.skin_file()
     if path is None:
         raise AvatarError(f"{human.recipe.skin_material}: no such skin material file")
-    if material_from_file(path).base_color_texture is None:
+    if "diffuseTexture" not in mhmat.texture_paths(mhmat.read(path), path.parent, path):
         raise AvatarError(f"{path}: the skin has no diffuse texture")
 
 

@@ -28,11 +28,13 @@ log = logging.getLogger(__name__)
 @dataclass(frozen=True)
 class SkinEntry:
     """One skin: its name (the material's ``name`` line, else the file's stem), its
-    ``.mhmat`` path and its thumbnail (a ``.thumb`` or ``.png`` beside it, else None)."""
+    ``.mhmat`` path and its thumbnail: a ``.thumb`` or ``.png`` beside it, else its diffuse
+    texture (an unwrapped skin, shrunk to an icon, still shows its tone: a plain button for
+    every user skin without a picture gave nothing to choose by)."""
 
     name: str
     path: str
-    thumbnail: str | None
+    thumbnail: str
 
 
 def list_skins(folders: Iterable[str | os.PathLike[str]]) -> list[SkinEntry]:
@@ -69,9 +71,9 @@ def _entry(path: Path) -> SkinEntry | None:
         return None
     if "diffuseTexture" not in textures:
         return None
-    thumbnail = next((str(t) for t in (path.with_suffix(".thumb"), path.with_suffix(".png"))
-                      if t.is_file()), None)  # fmt: skip
-    return SkinEntry(material.name or path.stem, str(path), thumbnail)
+    beside = (path.with_suffix(".thumb"), path.with_suffix(".png"))
+    thumbnail = next((t for t in beside if t.is_file()), textures["diffuseTexture"])
+    return SkinEntry(material.name or path.stem, str(path), str(thumbnail))
 
 
 def find_skin(name_or_path: str, folders: Iterable[str | os.PathLike[str]]) -> str:
