@@ -891,10 +891,13 @@ def hang_cards(
                        clear=clear.reshape(path.shape[:2]))
 
 
-BOB_SIDE_GAP_M = 0.008  # a bob's hanging cards over the sides of the head: this far off it
+BOB_SIDE_GAP_M = 0.006  # a bob's hanging cards over the sides of the head: this far off it
 # ... and their edges at least this far off the skin there: a card drawn in over the ear
 # came within 2 mm of its back by an edge, which lay 2 mm inside a small child's ear.
 BOB_EDGE_GAP_M = 0.005
+# The head a bob lies over at its sides is wrapped (``_wrapped``) from this far below the
+# eyes up: the ears' lobes (under them the hair hangs in, ``_hang_in``).
+BOB_WRAP_BELOW_M = 0.06
 
 
 def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
@@ -911,10 +914,10 @@ def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
     target = gap + (np.minimum(gap, BOB_SIDE_GAP_M) - gap) * w
     rel = points[:, :2] - centre[:2]
     radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
-    limit = _head_radius(body, centre, points) + BOB_SIDE_GAP_M
-    inward = np.maximum(radius - limit, 0) * w
+    limit = _head_radius(body, centre, points, hull_below=BOB_WRAP_BELOW_M) + BOB_SIDE_GAP_M
+    moved = radius + (limit - radius) * w
     out = points.astype(np.float64).copy()
-    out[:, :2] = centre[:2] + rel * ((radius - inward) / radius)[:, None]
+    out[:, :2] = centre[:2] + rel * (moved / radius)[:, None]
     return _off_skin(body, out, target)
 
 
@@ -937,13 +940,14 @@ def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
 
 def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
                  step_deg: float = 3.0, step_z: float = 0.004,
-                 reach_deg: float = 12.0) -> np.ndarray:  # fmt: skip
+                 reach_deg: float = 12.0, hull_below: float | None = None) -> np.ndarray:  # fmt: skip
     """(N,) m from the vertical axis through ``centre`` to the outermost skin of the head
     (ears included) about the direction and at the height of each point (N, 3): the most
     of the skin vertices' in a grid of ``step_deg`` by ``step_z`` cells round the axis,
     widened by ``reach_deg`` round it (a card's half width: a card drawn in by its middle
     in front of an ear cut through the ear by its edge) and a cell up and down, read
-    bilinearly."""
+    bilinearly. ``hull_below``: m below ``centre`` from which up the head is wrapped
+    (``_wrapped``: what hair drawn taut over it lies on; None: the skin itself)."""
     from scipy.ndimage import map_coordinates, maximum_filter
 
     skin = body.vertices[:BODY_VERTICES]
@@ -955,11 +959,60 @@ def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
     keep = (grid_z >= 0) & (grid_z < shape[1])
     table = np.zeros(shape)
     np.maximum.at(table, (grid_a[keep], grid_z[keep]), np.hypot(rel[keep, 0], rel[keep, 1]))
-    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3), mode="wrap")
+    # Round the head, not from its top to the shoulders (wrapped, its top row was theirs).
+    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3),
+                           mode=("wrap", "constant"))  # fmt: skip
+    if hull_below is not None:
+        low = int((0.2 - hull_below) / step_z)
+        table[:, low:] = _wrapped(table[:, low:], step_deg, step_z)
     q = points - centre
     at = np.stack([(np.degrees(np.arctan2(q[:, 0], -q[:, 1])) + 180) / step_deg - 0.5,
                    (q[:, 2] + 0.2) / step_z - 0.5])  # fmt: skip
     return map_coordinates(table, at, order=1, mode="nearest")
+
+
+def _wrapped(table: np.ndarray, step_deg: float, step_z: float) -> np.ndarray:
+    """(A, Z) radii (m) of the head round its vertical axis (``A`` directions ``step_deg``
+    apart from the back, ``Z`` heights ``step_z`` apart, up; 0 where no skin is) wrapped
+    as hair drawn over it wraps it: each height's outline round the axis by its convex
+    hull, then each direction's profile up the head by its own (no hollow between the
+    skull over the ear and the ear's rim, nor behind the ear). Hair hugging the skin's
+    outline instead stood out over each ear in a round lump, an ear-muff, with a step
+    above it and a groove behind it."""
+    angle = np.radians((np.arange(table.shape[0]) + 0.5) * step_deg - 180)
+    across = np.stack([np.sin(angle), -np.cos(angle)], 1)  # (A, 2) unit directions
+    out = table.copy()
+    for z in range(table.shape[1]):  # round the axis, from it
+        out[:, z] = _hull_reach(out[:, z, None] * across, across, np.zeros(2), out[:, z])
+    height = np.arange(table.shape[1]) * step_z
+    up = np.array([0.0, 1.0])
+    for a in range(table.shape[0]):  # up the head, out from the axis
+        on_axis = np.stack([height, np.zeros_like(height)], 1)
+        out[a] = _hull_reach(np.stack([height, out[a]], 1), up, on_axis, out[a])
+    return out
+
+
+def _hull_reach(points: np.ndarray, direction: np.ndarray, start: np.ndarray,
+                radius: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(N,) how far the convex hull of 2-D ``points`` (N, 2) with ``start`` ((2,) or (N,
+    2), inside it) reaches along ``direction`` ((N, 2) or (2,), unit) from each start:
+    ``radius`` (N,) (the points' own distances) where the points with a radius are too
+    few or in a line to make a hull. Over the hull's edges facing that way, the least
+    distance to the edge's line; never less than ``radius``, nor more than the farthest
+    point reaches."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    on = radius > 0
+    corners = np.vstack([points[on], np.reshape(start, (-1, 2))])
+    try:
+        hull = ConvexHull(corners)
+    except (QhullError, ValueError):  # flat or empty: nothing to wrap
+        return radius
+    normal, offset = hull.equations[:, :2], hull.equations[:, 2]
+    facing = np.broadcast_to(direction @ normal.T, (len(radius), len(offset)))
+    room = -(offset + np.broadcast_to(start, (len(radius), 2)) @ normal.T)
+    reach = np.where(facing > 1e-6, room / np.maximum(facing, 1e-6), np.inf).min(axis=1)
+    return np.clip(reach, radius, radius.max())
 
 
 def _side_weight(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
