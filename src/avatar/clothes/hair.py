@@ -677,6 +677,7 @@ SIDE_LOCKS_END = (-0.3, -0.19)  # ... and end here (m from the eyes): down the u
 # Below the jaw (m from the eyes) they turn back to the hair down the back, fully this
 # far further down (over the top of the shoulder).
 SIDE_LOCKS_TURN_Z = (-0.14, -0.1)
+SIDE_LOCKS_GATHER = 0.85  # ... drawn in across the back to this share of their width
 
 
 def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024,
@@ -730,9 +731,8 @@ def _into_the_back_hair(body: AuthoringBody, path: np.ndarray, lift: np.ndarray,
     flat = path.reshape(-1, 3)
     z = flat[:, 2]
     # Each guide's x and depth (y) at every point's height (the guides fall downwards).
-    at = [(np.interp(z, c[::-1, 2], c[::-1, 0]), np.interp(z, c[::-1, 2], c[::-1, 1]))
-          for c in g]  # fmt: skip
-    gx, gy = (np.stack(v, 1) for v in zip(*at))  # (P, G)
+    gx = np.stack([np.interp(z, c[::-1, 2], c[::-1, 0]) for c in g], 1)  # (P, G)
+    gy = np.stack([np.interp(z, c[::-1, 2], c[::-1, 1]) for c in g], 1)
     x = np.clip(flat[:, 0], gx.min(axis=1), gx.max(axis=1))
     order = np.argsort(gx, axis=1)
     gx, gy = np.take_along_axis(gx, order, 1), np.take_along_axis(gy, order, 1)
@@ -740,7 +740,9 @@ def _into_the_back_hair(body: AuthoringBody, path: np.ndarray, lift: np.ndarray,
     low, high = eye_z + np.array(SIDE_LOCKS_TURN_Z)
     w = np.clip((high - z) / (high - low), 0, 1)
     w = w * w * (3 - 2 * w)
-    target = np.stack([x, depth, z], 1)
+    # Gathered in a little across the back (their own width kept, the shoulders' slope
+    # under them pushed them out again).
+    target = np.stack([x * SIDE_LOCKS_GATHER, depth, z], 1)
     out = flat + w[:, None] * (target - flat)
     moved = w > 0  # (only those: pushed off the skin again, points beside an ear moved)
     out[moved] = _off_skin(body, out[moved], np.repeat(lift, path.shape[1])[moved])
@@ -1002,7 +1004,8 @@ def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
 
 def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
                  step_deg: float = 3.0, step_z: float = 0.004,
-                 reach_deg: float = 12.0, hull_below: float | None = None) -> np.ndarray:  # fmt: skip
+                 reach_deg: float = 12.0,
+                 hull_below: float | None = None) -> np.ndarray:  # fmt: skip
     """(N,) m from the vertical axis through ``centre`` to the outermost skin of the head
     (ears included) about the direction and at the height of each point (N, 3): the most
     of the skin vertices' in a grid of ``step_deg`` by ``step_z`` cells round the axis,
