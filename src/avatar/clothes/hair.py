@@ -676,7 +676,7 @@ SIDE_LOCKS_Z = (0.0, 0.05)  # ... at these heights above the eyes (under the gro
 SIDE_LOCKS_END = (-0.3, -0.19)  # ... and end here (m from the eyes): down the upper back
 # Below the jaw (m from the eyes) they turn back to the hair down the back, fully this
 # far further down (over the top of the shoulder).
-SIDE_LOCKS_TURN_Z = (-0.14, -0.1)
+SIDE_LOCKS_TURN_Z = (-0.15, -0.11)
 SIDE_LOCKS_GATHER = 0.85  # ... drawn in across the back to this share of their width
 
 
