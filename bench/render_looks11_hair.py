@@ -8,7 +8,10 @@ mid-stride.
     python bench/render_looks11_hair.py bob11woman|long11heavy|... --views profile
     python bench/render_looks11_hair.py sheet BEFORE_DIR AFTER_DIR OUT.png bob11_back ...
 
-``sheet`` puts the renders of two folders one over the other (before, after). Needs the
+``sheet`` puts the renders of two folders one over the other (before, after). The docs'
+pictures: ``bob11 --views front,back --size 260 --samples 10`` then ``sheet ... bob11_front
+bob11_back`` (looks11_hair_bob.png); ``long11 --views front`` (looks11_hair_long_front.png)
+and ``long11woman --views profile --size 300`` (looks11_hair_long_profile.png). Needs the
 pip ``bpy`` module (Cycles on the CPU).
 """
 
