@@ -673,14 +673,19 @@ def long_cards(
 
 SIDE_LOCKS_DEG = (55, 150)  # long hair's side locks root this far round the head ...
 SIDE_LOCKS_Z = (0.0, 0.05)  # ... at these heights above the eyes (under the grown hair)
-SIDE_LOCKS_END = (-0.22, -0.13)  # ... and end here (m from the eyes): on the shoulders
+SIDE_LOCKS_END = (-0.3, -0.19)  # ... and end here (m from the eyes): down the upper back
+# Below the jaw (m from the eyes) they turn back to the hair down the back, fully this
+# far further down (over the top of the shoulder).
+SIDE_LOCKS_TURN_Z = (-0.15, -0.11)
+SIDE_LOCKS_GATHER = 0.85  # ... drawn in across the back to this share of their width
 
 
 def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024,
-               layers=(0.004, 0.016), segments: int = 10, seed: int = 5) -> Piece:  # fmt: skip
+               layers=(0.004, 0.016), segments: int = 12, seed: int = 5) -> Piece:  # fmt: skip
     """Long hair over the sides of the head: locks rooted above and around the ears
     (``SIDE_LOCKS_*``), combed along ``flow`` and falling over and behind the ears, then
-    straight down at the ears' width (``_fall_clear``) to the shoulders, each at its own
+    straight down at the ears' width (``_fall_clear``), and under the jaw back over the
+    shoulders into the hair down the back (``_into_the_back_hair``), each at its own
     height ``layers`` (m) off the skin. MakeHuman's hair ribbons all fall down the back
     (or over the chest): grown from them alone, long hair narrowed under the ears, short
     hair over the ears above long locks down the back (a mullet), and the scalp showed
@@ -694,11 +699,11 @@ def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024
     roots = _scatter(body, keep, count, rng)
     lift = rng.uniform(layers[0], layers[1], count)
     stop = eye_z + rng.uniform(SIDE_LOCKS_END[0], SIDE_LOCKS_END[1], count)
-    step = 0.3 / segments
+    step = 0.36 / segments
     rows, point = [roots], roots
     for k in range(1, segments + 1):
         along = _tangent(body, point, flow(point, centre, eye_z))
-        fall = np.clip(k / segments * 4, 0, 1)  # combed a little way, then hanging
+        fall = np.clip(k * step / 0.075, 0, 1)  # combed 7.5 cm, then hanging
         direction = along * (1 - fall) + np.array([0, 0, -1.0]) * fall
         direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-9)
         gap = 0.002 + (lift - 0.002) * min(1.0, k / 3)
@@ -706,10 +711,42 @@ def side_locks(body: AuthoringBody, flow, count: int = 160, width: float = 0.024
         point = _clear_of_the_ears(body, point, gap, centre, (eye_z - 0.09, eye_z + 0.03))
         rows.append(point)
     path = _fall_clear(np.stack(rows, 1), centre, eye_z + 0.03)
-    path = _cut_at(_finer(path, 3), stop)[:, ::3]
+    path = _into_the_back_hair(body, _finer(path, 3), lift, eye_z)
+    path = _cut_at(path, stop)[:, ::3]
     normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
     inner = 1 - (lift - layers[0]) / (layers[1] - layers[0])
     return _card_piece(body, path, normal, width, rng, root_v=LONG_ROOT_V - LONG_INNER_V * inner)
+
+
+def _into_the_back_hair(body: AuthoringBody, path: np.ndarray, lift: np.ndarray,
+                        eye_z: float) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) side locks' paths whose points below the jaw (``SIDE_LOCKS_TURN_Z``) are
+    drawn back to the hair down the back: to the depth of MakeHuman's hair guides
+    (``guides``, which the long locks hang from) at their height and across the back, no
+    wider than the outermost guide, and ``lift`` (N,) m off the skin. Falling straight
+    down at the ears' width, the locks met the slope of the shoulders and slid off it
+    every way, fanned out over the shoulders, and from the side they ended there, a
+    layer of their own in front of the hair down the back."""
+    g = guides(body, 16)  # (G, S, 3) across the back, from one side to the other
+    flat = path.reshape(-1, 3)
+    z = flat[:, 2]
+    # Each guide's x and depth (y) at every point's height (the guides fall downwards).
+    gx = np.stack([np.interp(z, c[::-1, 2], c[::-1, 0]) for c in g], 1)  # (P, G)
+    gy = np.stack([np.interp(z, c[::-1, 2], c[::-1, 1]) for c in g], 1)
+    x = np.clip(flat[:, 0], gx.min(axis=1), gx.max(axis=1))
+    order = np.argsort(gx, axis=1)
+    gx, gy = np.take_along_axis(gx, order, 1), np.take_along_axis(gy, order, 1)
+    depth = np.array([np.interp(xi, a, b) for xi, a, b in zip(x, gx, gy, strict=True)])
+    low, high = eye_z + np.array(SIDE_LOCKS_TURN_Z)
+    w = np.clip((high - z) / (high - low), 0, 1)
+    w = w * w * (3 - 2 * w)
+    # Gathered in a little across the back (their own width kept, the shoulders' slope
+    # under them pushed them out again).
+    target = np.stack([x * SIDE_LOCKS_GATHER, depth, z], 1)
+    out = flat + w[:, None] * (target - flat)
+    moved = w > 0  # (only those: pushed off the skin again, points beside an ear moved)
+    out[moved] = _off_skin(body, out[moved], np.repeat(lift, path.shape[1])[moved])
+    return out.reshape(path.shape)
 
 
 LONG_ROOT_V = 0.4  # long cards' texture starts here at the roots (0.5: the darkest roots)
@@ -882,7 +919,7 @@ def hang_cards(
     fine = _hang_in(body, fine, centre, eye_z - 0.055)
     stop = stop + _layers(path, centre, ~front, np.random.default_rng([seed, count, 7]))
     path = _curl_in(body, _cut_at(fine, stop)[:, ::3], centre)
-    normal = body.outward(path.reshape(-1, 3)).reshape(path.shape)
+    normal = _facing_out(body, path, centre, eye_z)
     # A blunt cut: cards to the end, their strands cut there rather than thinning out
     # (tapered, thinned tips a centimetre apart read as frayed ends), narrowing a little
     # as the ends turn in.
@@ -891,10 +928,13 @@ def hang_cards(
                        clear=clear.reshape(path.shape[:2]))
 
 
-BOB_SIDE_GAP_M = 0.008  # a bob's hanging cards over the sides of the head: this far off it
+BOB_SIDE_GAP_M = 0.005  # a bob's hanging cards over the sides of the head: this far off it
 # ... and their edges at least this far off the skin there: a card drawn in over the ear
 # came within 2 mm of its back by an edge, which lay 2 mm inside a small child's ear.
 BOB_EDGE_GAP_M = 0.005
+# The head a bob lies over at its sides is wrapped (``_wrapped``) from this far below the
+# eyes up: the ears' lobes (under them the hair hangs in, ``_hang_in``).
+BOB_WRAP_BELOW_M = 0.06
 
 
 def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
@@ -909,13 +949,40 @@ def _hug_the_sides(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
     skin instead, a card's point came to lie in the fold behind a woman's ear.)"""
     w = _side_weight(points, centre, eye_z)
     target = gap + (np.minimum(gap, BOB_SIDE_GAP_M) - gap) * w
+    return _off_skin(body, _onto_the_wrap(body, points, centre, w), target)
+
+
+def _facing_out(body: AuthoringBody, path: np.ndarray, centre: np.ndarray,
+                eye_z: float) -> np.ndarray:  # fmt: skip
+    """(N, K, 3) unit normals for a bob's cards along ``path`` (N, K, 3): the skin's, but
+    over the sides of the head (``_side_weight``) turned to face straight out from its
+    vertical axis (through ``centre``), as the wrapped head they lie on does. Facing the
+    nearest skin's normal there (the ear's, which faces forward or back), cards were
+    turned edge-on to the head and their edges stood up to 8 mm out of the hair: lumps at
+    ear level."""
+    flat = path.reshape(-1, 3)
+    skin = body.outward(flat)
+    radial = np.zeros_like(skin)
+    radial[:, :2] = flat[:, :2] - centre[:2]
+    radial /= np.maximum(np.linalg.norm(radial, axis=1, keepdims=True), 1e-9)
+    w = _side_weight(flat, centre, eye_z)[:, None]
+    normal = skin * (1 - w) + radial * w
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-9)
+    return normal.reshape(path.shape)
+
+
+def _onto_the_wrap(body: AuthoringBody, points: np.ndarray, centre: np.ndarray,
+                   weight: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(N, 3) points moved by ``weight`` (N,) 0..1 of the way along their radius from the
+    head's vertical axis (through ``centre``) to ``BOB_SIDE_GAP_M`` outside the head
+    wrapped (``_head_radius`` with ``BOB_WRAP_BELOW_M``)."""
     rel = points[:, :2] - centre[:2]
     radius = np.maximum(np.linalg.norm(rel, axis=1), 1e-9)
-    limit = _head_radius(body, centre, points) + BOB_SIDE_GAP_M
-    inward = np.maximum(radius - limit, 0) * w
+    limit = _head_radius(body, centre, points, hull_below=BOB_WRAP_BELOW_M) + BOB_SIDE_GAP_M
+    moved = radius + (limit - radius) * weight
     out = points.astype(np.float64).copy()
-    out[:, :2] = centre[:2] + rel * ((radius - inward) / radius)[:, None]
-    return _off_skin(body, out, target)
+    out[:, :2] = centre[:2] + rel * (moved / radius)[:, None]
+    return out
 
 
 def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
@@ -937,13 +1004,15 @@ def _clear_of_the_ears(body: AuthoringBody, points: np.ndarray, gap: np.ndarray,
 
 def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
                  step_deg: float = 3.0, step_z: float = 0.004,
-                 reach_deg: float = 12.0) -> np.ndarray:  # fmt: skip
+                 reach_deg: float = 12.0,
+                 hull_below: float | None = None) -> np.ndarray:  # fmt: skip
     """(N,) m from the vertical axis through ``centre`` to the outermost skin of the head
     (ears included) about the direction and at the height of each point (N, 3): the most
     of the skin vertices' in a grid of ``step_deg`` by ``step_z`` cells round the axis,
     widened by ``reach_deg`` round it (a card's half width: a card drawn in by its middle
     in front of an ear cut through the ear by its edge) and a cell up and down, read
-    bilinearly."""
+    bilinearly. ``hull_below``: m below ``centre`` from which up the head is wrapped
+    (``_wrapped``: what hair drawn taut over it lies on; None: the skin itself)."""
     from scipy.ndimage import map_coordinates, maximum_filter
 
     skin = body.vertices[:BODY_VERTICES]
@@ -955,11 +1024,62 @@ def _head_radius(body: AuthoringBody, centre: np.ndarray, points: np.ndarray,
     keep = (grid_z >= 0) & (grid_z < shape[1])
     table = np.zeros(shape)
     np.maximum.at(table, (grid_a[keep], grid_z[keep]), np.hypot(rel[keep, 0], rel[keep, 1]))
-    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3), mode="wrap")
+    # Round the head, not from its top to the shoulders (wrapped, its top row was theirs).
+    table = maximum_filter(table, size=(2 * int(reach_deg / step_deg) + 1, 3),
+                           mode=("wrap", "constant"))  # fmt: skip
+    if hull_below is not None:
+        low = int((0.2 - hull_below) / step_z)
+        table[:, low:] = _wrapped(table[:, low:], step_deg, step_z)
     q = points - centre
     at = np.stack([(np.degrees(np.arctan2(q[:, 0], -q[:, 1])) + 180) / step_deg - 0.5,
                    (q[:, 2] + 0.2) / step_z - 0.5])  # fmt: skip
     return map_coordinates(table, at, order=1, mode="nearest")
+
+
+def _wrapped(table: np.ndarray, step_deg: float, step_z: float) -> np.ndarray:
+    """(A, Z) radii (m) of the head round its vertical axis (``A`` directions ``step_deg``
+    apart from the back, ``Z`` heights ``step_z`` apart, up; 0 where no skin is) wrapped
+    as hair drawn over it wraps it: each height's outline round the axis by its convex
+    hull, then each direction's profile up the head by its own (no hollow between the
+    skull over the ear and the ear's rim, nor behind the ear). Hair hugging the skin's
+    outline instead stood out over each ear in a round lump, an ear-muff, with a step
+    above it and a groove behind it. Below each direction's widest point the radius stays
+    (hair falls straight past it)."""
+    angle = np.radians((np.arange(table.shape[0]) + 0.5) * step_deg - 180)
+    across = np.stack([np.sin(angle), -np.cos(angle)], 1)  # (A, 2) unit directions
+    out = table.copy()
+    for z in range(table.shape[1]):  # round the axis, from it
+        out[:, z] = _hull_reach(out[:, z, None] * across, across, np.zeros(2), out[:, z])
+    height = np.arange(table.shape[1]) * step_z
+    up = np.array([0.0, 1.0])
+    for a in range(table.shape[0]):  # up the head, out from the axis
+        on_axis = np.stack([height, np.zeros_like(height)], 1)
+        out[a] = _hull_reach(np.stack([height, out[a]], 1), up, on_axis, out[a])
+    # Straight down past the widest point (hair falls past the ears, not in under them).
+    return np.maximum.accumulate(out[:, ::-1], axis=1)[:, ::-1]
+
+
+def _hull_reach(points: np.ndarray, direction: np.ndarray, start: np.ndarray,
+                radius: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(N,) how far the convex hull of 2-D ``points`` (N, 2) with ``start`` ((2,) or (N,
+    2), inside it) reaches along ``direction`` ((N, 2) or (2,), unit) from each start:
+    ``radius`` (N,) (the points' own distances) where the points with a radius are too
+    few or in a line to make a hull. Over the hull's edges facing that way, the least
+    distance to the edge's line; never less than ``radius``, nor more than the farthest
+    point reaches."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    on = radius > 0
+    corners = np.vstack([points[on], np.reshape(start, (-1, 2))])
+    try:
+        hull = ConvexHull(corners)
+    except (QhullError, ValueError):  # flat or empty: nothing to wrap
+        return radius
+    normal, offset = hull.equations[:, :2], hull.equations[:, 2]
+    facing = np.broadcast_to(direction @ normal.T, (len(radius), len(offset)))
+    room = -(offset + np.broadcast_to(start, (len(radius), 2)) @ normal.T)
+    reach = np.where(facing > 1e-6, room / np.maximum(facing, 1e-6), np.inf).min(axis=1)
+    return np.clip(reach, radius, radius.max())
 
 
 def _side_weight(points: np.ndarray, centre: np.ndarray, eye_z: float) -> np.ndarray:
