@@ -22,10 +22,13 @@ from avatar.clothes.binding import Binding, axis_scale, make_binding
 from avatar.clothes.regions import limb_coordinates
 
 # Chain coordinates (0 shoulder or hip joint, 0.5 elbow or knee, 1 wrist or ankle) over
-# which the ease hands over from the body's scale to the limb's: the top of the thigh and
-# the upper arm stay with the body's (the crotch, the armpit and the seat span between
-# parts there), the limb's own from above the knee and the elbow down.
-LIMB_FROM, LIMB_TO = 0.2, 0.35
+# which the ease hands over from the body's scale to the limb's (legs, arms): the top of
+# the thigh and the upper arm stay with the body's (the crotch, the seat and the armpit
+# span between parts there; on the heavy man's upper arm, pressed to his side, the ring
+# across the arm took in the side of the chest and his jacket's sleeve shrank by a tenth),
+# the limb's own from above the knee and at the elbow down.
+LEG_FROM, LEG_TO = 0.2, 0.35
+ARM_FROM, ARM_TO = 0.35, 0.5
 SLAB = 0.01  # m either side of a vertex along the limb: the shell's ring about it
 
 
@@ -68,12 +71,13 @@ def across_the_limbs(body: AuthoringBody, points: np.ndarray, binding: Binding) 
 
 def limb_share(body: AuthoringBody, points: np.ndarray, binding: Binding) -> np.ndarray:
     """(N,) 0..1: how much of each point's ease follows the limb under it: 0 off the arms
-    and legs (by the part of its nearest reference) and above ``LIMB_FROM`` along them,
-    1 from ``LIMB_TO`` down, a smoothstep between."""
+    and legs (by the part of its nearest reference) and above ``LEG_FROM`` / ``ARM_FROM``
+    along them, 1 from ``LEG_TO`` / ``ARM_TO`` down, a smoothstep between."""
     arm, leg = limb_coordinates(points, body.marks)
     part = body.part[binding.indices[np.arange(len(points)), np.argmax(binding.weights, 1)]]
-    along = np.where(part == "arm", arm, np.where(part == "leg", leg, -1.0))
-    t = np.clip((along - LIMB_FROM) / (LIMB_TO - LIMB_FROM), 0, 1)
+    on_arm = np.clip((arm - ARM_FROM) / (ARM_TO - ARM_FROM), 0, 1)
+    on_leg = np.clip((leg - LEG_FROM) / (LEG_TO - LEG_FROM), 0, 1)
+    t = np.where(part == "arm", on_arm, np.where(part == "leg", on_leg, 0.0))
     return t * t * (3 - 2 * t)
 
 
