@@ -12,7 +12,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from avatar.clothes import face, hair, headwear, hems, jacket, shoes, tailoring
 from avatar.clothes.authoring import (
@@ -30,7 +29,6 @@ from avatar.clothes.authoring import (
     seat_share,
     with_box_uvs,
 )
-from avatar.clothes.binding import axis_scale, make_binding
 from avatar.clothes.fitting import CLEARANCE, Garment
 from avatar.clothes.limb_ease import across_the_limbs
 from avatar.clothes.regions import face_features
@@ -92,8 +90,7 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0, snug: float |
     if snug is not None:
         return bound(body, mesh, body.skin_faces)
     midline = MIDLINE_SPAN / 2 if bridge else 0.0
-    piece = round_the_limbs(body, bound(body, mesh, faces, midline=midline))
-    return on_the_thighs(body, piece) if fly else piece
+    return round_the_limbs(body, bound(body, mesh, faces, midline=midline))
 
 
 def round_the_limbs(body: AuthoringBody, piece: Piece) -> Piece:
@@ -200,46 +197,6 @@ def fly_share(body: AuthoringBody, mesh: Mesh) -> np.ndarray:
     t = np.clip((v[:, 2] - crotch + FLY_SEAM) / FLY_RISE, 0, 1)
     across = np.clip(1 - np.abs(v[:, 0]) / reach, 0, 1)
     return np.where(front, t * t * (3 - 2 * t) * across, 0.0)
-
-
-def on_the_thighs(body: AuthoringBody, piece: Piece) -> Piece:
-    """``piece`` with its cloth across the fly (``across_the_fly``) bound to the crowns of
-    both thighs as well as to the groin under it: each vertex on the front between the hip
-    joints, above the crotch point, the share ``w`` of the way it stands from its nearest
-    reference towards the shell's front-most vertices in its row on the left and right
-    thighs, weights (1 - w, w / 2, w / 2) on the three. Bound to the groin alone, the
-    bridge's depth scaled with the body's: a child's thighs stand further forward of the
-    groin for their size (at age 0.15 the body's scale is 0.87 front to back) and the
-    cloth at the midline fell back between them, a V at the crotch point 1.9 times as deep
-    for the hips' width as the woman's. Now it spans from crown to crown on every body."""
-    v = piece.mesh.vertices.astype(np.float64)
-    x = body.vertices.astype(np.float64)
-    b = piece.binding
-    hip = body.marks.hip
-    reach = abs(float(hip[0, 0]))
-    crotch = float(v[np.abs(v[:, 0]) < 0.015, 2].min())
-    pick = np.flatnonzero((v[:, 1] < hip[0, 1]) & (np.abs(v[:, 0]) < reach)
-                          & (v[:, 2] > crotch) & (v[:, 2] < hip[0, 2]))  # fmt: skip
-    shell = np.unique(b.indices)
-    crowns = shell[(x[shell, 1] < hip[0, 1]) & (x[shell, 0] > 0.01) & (x[shell, 0] < reach)]
-    if len(pick) == 0 or len(crowns) == 0:
-        return piece
-    near = b.indices[pick, np.argmax(b.weights[pick], axis=1)]
-    row = np.abs(v[pick, None, 2] - x[None, crowns, 2]) < 0.015  # (P, C) about level
-    left = crowns[np.argmin(np.where(row, x[None, crowns, 1], np.inf), axis=1)]
-    right = shell[cKDTree(x[shell]).query(x[left] * np.array([-1.0, 1.0, 1.0]))[1]]
-    depth = (x[left, 1] + x[right, 1]) / 2
-    gap = x[near, 1] - depth  # how far the groin under it lies behind the crowns
-    w = np.where(row.any(axis=1) & (gap > 0.005),
-                 np.clip((x[near, 1] - v[pick, 1]) / np.maximum(gap, 0.005), 0, 1), 0.0)
-    indices, weights = b.indices.copy(), b.weights.copy()
-    offsets = b.offsets.copy()
-    indices[pick] = np.stack([near, left, right], axis=1)
-    weights[pick] = np.stack([1 - w, w / 2, w / 2], axis=1)
-    anchor = np.einsum("nk,nkd->nd", weights[pick], x[indices[pick]])
-    offsets[pick] = (v[pick] - anchor) / axis_scale(b, x)
-    return replace(piece, binding=make_binding(indices, weights, offsets, b.scale_refs,
-                                               b.scale_lengths))  # fmt: skip
 
 
 def _vertex_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -359,7 +316,7 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
                   0.002)  # fmt: skip
     mesh = level_hems(mesh, reach=0.012)  # the bands' inner edges, as the hems
     marks = (tailoring.jeans_marks if kind == "jeans" else tailoring.trouser_marks)(panels, h)
-    piece = join([on_the_thighs(body, round_the_limbs(body, bound(body, mesh, faces))),
+    piece = join([round_the_limbs(body, bound(body, mesh, faces)),
                   tailoring.belt_loops(body, mesh, h, faces)])
     metal = None if kind == "jeans" else tailoring.HORN
     return replace(piece, layout=tailoring.layout(panels, marks, thread, metal))
