@@ -166,6 +166,18 @@ def test_loose_bottoms_span_the_front_of_the_crotch(name, params):
 
 
 
+def test_childs_sweatpants_cover_the_crotch_point_from_the_front():
+    """Just above the crotch point the child's sweatpants left a V open at the midline:
+    seen from the front, 3 and 4 cm above it no cloth crossed the midline at all (the
+    thighs' cloth, eased for the body's size, not the child's thin thighs, stood apart).
+    Eased for the thighs (``limb_ease``) the cloth at the midline there stands less than
+    3 cm behind the cloth over the thighs."""
+    human = Human(CHILD).dressed("sweatpants")
+    setbacks = _fly_setbacks(human, "sweatpants")[:3]  # 3, 4 and 5 cm above the crotch point
+    assert np.isfinite(setbacks).all(), np.round(setbacks * 1000)
+    assert setbacks.max() < 0.03, np.round(setbacks * 1000)
+
+
 def _fly_turns(human: Human, frames=range(2, 12, 2)) -> np.ndarray:
     """(frames,) degrees: the most any two neighbouring faces of the first garment over
     the fly (facing forward at rest, between the hip joints' x, from the crotch point up
