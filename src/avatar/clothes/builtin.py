@@ -30,6 +30,7 @@ from avatar.clothes.authoring import (
     with_box_uvs,
 )
 from avatar.clothes.fitting import CLEARANCE, Garment
+from avatar.clothes.limb_ease import across_the_limbs
 from avatar.clothes.regions import face_features
 from avatar.looks import fabrics, facial_hair, tailored, textures
 from avatar.material import Material
@@ -88,7 +89,14 @@ def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0, snug: float |
     # by different amounts on different bodies: bound to it, the seat sagged again).
     if snug is not None:
         return bound(body, mesh, body.skin_faces)
-    return bound(body, mesh, faces, midline=MIDLINE_SPAN / 2 if bridge else 0.0)
+    midline = MIDLINE_SPAN / 2 if bridge else 0.0
+    return round_the_limbs(body, bound(body, mesh, faces, midline=midline))
+
+
+def round_the_limbs(body: AuthoringBody, piece: Piece) -> Piece:
+    """``piece`` with its ease round the arms and legs scaling with each limb's girth
+    (``limb_ease.across_the_limbs``), not the body's size: a child's thin limbs."""
+    return replace(piece, binding=across_the_limbs(body, piece.mesh.vertices, piece.binding))
 
 
 def bridged(body: AuthoringBody, mesh: Mesh, passes: int = 12) -> Mesh:
@@ -308,7 +316,8 @@ def _tailored(body: AuthoringBody, kind: str, length: float, ease, hang: float,
                   0.002)  # fmt: skip
     mesh = level_hems(mesh, reach=0.012)  # the bands' inner edges, as the hems
     marks = (tailoring.jeans_marks if kind == "jeans" else tailoring.trouser_marks)(panels, h)
-    piece = join([bound(body, mesh, faces), tailoring.belt_loops(body, mesh, h, faces)])
+    piece = join([round_the_limbs(body, bound(body, mesh, faces)),
+                  tailoring.belt_loops(body, mesh, h, faces)])
     metal = None if kind == "jeans" else tailoring.HORN
     return replace(piece, layout=tailoring.layout(panels, marks, thread, metal))
 
