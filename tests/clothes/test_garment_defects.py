@@ -837,6 +837,58 @@ def test_dress_back_runs_on_across_the_waist_seam(params):
     assert max(turns) < 22.5, np.round(turns, 1)
 
 
+def _corner_angle_normals(v: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(V, 3) unit vertex normals of quads (F, 4) weighted by their corner angles: what
+    Blender shades a smooth mesh with when it carries no normals of its own."""
+    out = np.zeros_like(v)
+    for k in range(4):
+        a, b, c = v[faces[:, k - 1]], v[faces[:, k]], v[faces[:, (k + 1) % 4]]
+        n = np.cross(c - b, a - b)
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+        e1, e2 = a - b, c - b
+        cos = np.einsum("nd,nd->n", e1, e2) / np.maximum(
+            np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1), 1e-12)
+        np.add.at(out, faces[:, k], n * np.arccos(np.clip(cos, -1, 1))[:, None])
+    return out / np.maximum(np.linalg.norm(out, axis=1, keepdims=True), 1e-12)
+
+
+@pytest.mark.parametrize("params", [WOMAN_45, HEAVY_MAN])
+@pytest.mark.parametrize("frame", [None, 6])
+def test_dress_skirt_top_is_shaded_as_cloth_not_a_roll(params, frame):
+    """The skirt's top edge, 1.5 mm proud of the bodice, is a seam. The shell's hem quad
+    there (at right angles to the cloth) was averaged into its outer vertices' normals:
+    turned 40-45 degrees up out of the cloth, smooth shading spread a light edge over a
+    dark band down the whole top row of the skirt's faces (3-4 cm), a ledge across the
+    back. The normals the dress is shaded with (its part's, at rest and mid-stride) stay
+    within 5 degrees of the cloth's own there."""
+    from avatar.clothes import library
+    from avatar.clothes.authoring import boundary_edges
+    from avatar.mesh import vertex_normals
+
+    human = Human(params).dressed("dress")
+    fitted = human.outfit.garments[0]
+    part = library.garment_part(fitted)
+    v = fitted.mesh.vertices.astype(np.float64)
+    normals = part.normals
+    if frame is not None:
+        _, matrices = _mid_stride(human, frame)
+        body = skinning.linear_blend(human.vertices, human.weights, matrices)
+        v = human.outfit.frame(body, matrices, exact=True)[0].astype(np.float64)
+        normals = library.garment_normals(fitted, v)
+    faces = fitted.mesh.faces
+    if normals is None:
+        normals = _corner_angle_normals(v, faces)
+    n = len(fitted.garment.mesh.vertices)
+    outer = faces[np.all(faces >= n, axis=1)]
+    cloth = vertex_normals(v, outer).astype(np.float64)
+    rim = np.unique(boundary_edges(fitted.garment.mesh.faces)[0])
+    hip = v[:n, 2][_skirt_vertices(fitted)[:n]].min() + 0.3  # well above the skirt's hem
+    top = rim[_skirt_vertices(fitted)[rim] & (v[rim, 2] > hip)] + n
+    assert len(top) > 20
+    turned = np.degrees(np.arccos(np.clip(np.einsum("nd,nd->n", normals[top], cloth[top]), -1, 1)))
+    assert turned.max() < 5.0, np.round(np.percentile(turned, [50, 90, 100]), 1)
+
+
 # ---------------------------------------------------------------------------- hems
 
 
