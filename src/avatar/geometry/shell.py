@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar.mesh import Mesh, vertex_normals
+from avatar.mesh import Mesh, face_normals
 
 
 @dataclass(frozen=True)
@@ -89,8 +89,13 @@ def layer_normals(shell: Shell, vertices: np.ndarray) -> np.ndarray:
     proud of its bodice, read from behind as a step across the back (a light edge over a
     dark band)."""
     faces = shell.mesh.faces
-    layer = np.all(faces >= shell.count, axis=1) | np.all(faces < shell.count, axis=1)
-    return vertex_normals(np.asarray(vertices), faces[layer])
+    layer = faces[np.all(faces >= shell.count, axis=1) | np.all(faces < shell.count, axis=1)]
+    v = np.asarray(vertices, np.float64)
+    normal = face_normals(v, layer)  # area-weighted, as ``mesh.vertex_normals``
+    summed = np.stack([sum(np.bincount(layer[:, k], normal[:, axis], len(v))
+                           for k in range(layer.shape[1])) for axis in range(3)], 1)  # fmt: skip
+    size = np.linalg.norm(summed, axis=1, keepdims=True)
+    return (summed / np.maximum(size, 1e-12)).astype(np.float32)
 
 
 def extrude(inner: np.ndarray, normals: np.ndarray, thickness: float) -> np.ndarray:
