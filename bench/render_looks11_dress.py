@@ -4,6 +4,9 @@ straps, on a woman, a heavy man, a child and a heavy woman.
 
     python bench/render_looks11_dress.py waist --views back [--walk] --samples 12 --size 300
     python bench/render_looks11_dress.py straps --views front,back --samples 12 --size 300
+    python bench/render_looks11_dress.py pair BEFORE.png AFTER.png OUT.png  # before over after
+
+The before pictures come from the old code (a worktree of main on PYTHONPATH).
 
 Needs the pip ``bpy`` module (Cycles on the CPU).
 """
@@ -29,7 +32,25 @@ SETS = {"waist": DRESSED, "straps": DRESSED}
 FRAMING = {"waist": (0.6, 1.5, 0.9), "straps": (0.55, 1.6, 1.2)}
 
 
+def pair(before: str, after: str, out: str, width: int = 1000) -> None:
+    """``before`` over ``after`` in one PNG, ``width`` pixels wide (under 1.5 MB)."""
+    from PIL import Image
+
+    def opened(path):
+        image = Image.open(path).convert("RGB")
+        return image.resize((width, round(image.height * width / image.width)), Image.LANCZOS)
+
+    top, bottom = opened(before), opened(after)
+    both = Image.new("RGB", (max(top.width, bottom.width), top.height + bottom.height))
+    both.paste(top, (0, 0))
+    both.paste(bottom, (0, top.height))
+    both.save(out, optimize=True)
+
+
 def main() -> None:
+    if sys.argv[1:2] == ["pair"]:
+        pair(*sys.argv[2:5])
+        return
     closeups.SETS.update(SETS)
     closeups.FRAMING.update(FRAMING)
     closeups.main()
