@@ -151,7 +151,8 @@ def main() -> None:
 
 def _mid_stride(human, outfit, rest_parts):
     """The parts posed a quarter into the built-in walk (legs apart), garments resolved for
-    the frame (exact), walking in place."""
+    the frame (exact) and shaded as ``library.garment_part`` shades them, walking in place."""
+    from avatar.clothes.library import garment_normals
     from avatar.part import MeshPart
     from avatar.rig import kinematics, skinning
 
@@ -165,8 +166,10 @@ def _mid_stride(human, outfit, rest_parts):
     count = len(rest_parts) - len(garments)
     out = [MeshPart(p.name, p.mesh.with_vertices(body[human.part_vertices(p.name)] - shift),
                     p.material) for p in rest_parts[:count]]  # fmt: skip
-    return out + [MeshPart(p.name, p.mesh.with_vertices(v - shift), p.material)
-                  for p, v in zip(rest_parts[count:], garments, strict=True)]  # fmt: skip
+    return out + [MeshPart(p.name, p.mesh.with_vertices(v - shift), p.material,
+                           normals=garment_normals(g, v))
+                  for p, g, v in zip(rest_parts[count:], outfit.garments, garments,
+                                     strict=True)]  # fmt: skip
 
 
 SPACING, CROWN = 0.36, 1.8  # metres between heads; where every crown is put

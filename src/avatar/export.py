@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from avatar.clothes import bake
+from avatar.clothes import bake, library
 from avatar.errors import AvatarError, ParameterError
 from avatar.geometry.decimate import decimate
 from avatar.human import Human
@@ -74,14 +74,16 @@ def _posed(human: Human, parts: list[MeshPart], animation: Animation | None) -> 
     out = []
     for i, part in enumerate(parts):
         k = i - (len(parts) - garments)
+        normals = None
         if k >= 0:
             vertices = resolved[k]
+            normals = library.garment_normals(human.outfit.garments[k], vertices)
         elif part.skin is not None:
             skin = skinning.SkinWeights(part.skin[0].astype(np.int32), part.skin[1])
             vertices = skinning.linear_blend(part.mesh.vertices, skin, matrices)
         else:
             vertices = part.mesh.vertices
-        out.append(replace(part, mesh=part.mesh.with_vertices(vertices), normals=None))
+        out.append(replace(part, mesh=part.mesh.with_vertices(vertices), normals=normals))
     return out
 
 

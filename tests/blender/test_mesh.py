@@ -85,3 +85,31 @@ def test_shape_keys_are_offsets(empty_scene, rng):
     obj.data.shape_keys.key_blocks["smile"].value = 1.0
     posed = bridge.read_vertices(obj, evaluated=True)
     np.testing.assert_allclose(posed, mesh.vertices + delta, atol=1e-6)
+
+
+
+def test_shell_normals_reach_blender_unless_a_face_repeats_a_vertex(empty_scene):
+    """A garment part's own normals (``library.garment_normals``) become the object's
+    custom normals; on a mesh whose faces repeat a vertex (triangles padded to quads, the
+    hoodie's drawstrings) Blender segfaulted setting them, so such a part keeps Blender's."""
+    import bpy
+
+    from avatar.blender import mesh as bridge
+    from avatar.blender import scene
+    from avatar.mesh import Mesh
+    from avatar.part import MeshPart
+
+    grid = grid_mesh(3)
+    up = np.tile(np.float32([0.0, 0.6, 0.8]), (len(grid.vertices), 1))
+    collection = bpy.context.scene.collection
+    built = scene._build_part(MeshPart("flat", grid, None, normals=up), None, None, collection)
+    corner = np.empty(len(built.data.loops) * 3, np.float32)
+    built.data.loops.foreach_get("normal", corner)
+    np.testing.assert_allclose(corner.reshape(-1, 3), np.tile(up[0], (len(built.data.loops), 1)),
+                               atol=1e-3)  # fmt: skip
+    padded = grid.faces.copy()
+    padded[0, 3] = padded[0, 2]
+    assert bridge.repeats_corners(padded) and not bridge.repeats_corners(grid.faces)
+    part = MeshPart("padded", Mesh(grid.vertices, padded, grid.uvs, grid.face_uvs), None,
+                    normals=up)  # fmt: skip
+    assert scene._build_part(part, None, None, collection).name == "padded"

@@ -229,7 +229,8 @@ def _parts(human: Human, geo: Geometry) -> list[tuple[MeshPart, Mesh]]:
     for fitted in geo.outfit or ():
         part = library.garment_part(fitted)
         if fitted.name in looks:  # its variant, aged for the wearer, as Human.outfit has it
-            part = MeshPart(part.name, part.mesh, looks[fitted.name], part.skin)
+            part = MeshPart(part.name, part.mesh, looks[fitted.name], part.skin,
+                            normals=part.normals)
         out.append((part, part.mesh))
     return out
 

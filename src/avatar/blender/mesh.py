@@ -108,6 +108,13 @@ def set_normals(obj: bpy.types.Object, normals: np.ndarray) -> None:
     obj.data.normals_split_custom_set_from_vertices(np.asarray(normals, np.float32))
 
 
+def repeats_corners(faces: np.ndarray) -> bool:
+    """Whether any face (F, N) names a vertex twice (a triangle padded to a quad): Blender
+    crashed (segfault) setting custom normals on such a mesh (the hoodie's drawstrings)."""
+    f = np.asarray(faces)
+    return bool(np.any(f == np.roll(f, -1, axis=1)))
+
+
 def read_vertices(obj: bpy.types.Object, evaluated: bool = False) -> np.ndarray:
     """(V, 3) float32 vertex positions in object space; ``evaluated`` applies modifiers/keys."""
     if evaluated:

@@ -105,7 +105,7 @@ def _build_part(
     obj = mesh_bridge.new_mesh_object(part.name, part.mesh, collection)
     obj["avatar_part"] = part.name  # what the extension's live updates find it by
     obj.data.materials.append(material_bridge.material(part.material, part.name))
-    if part.normals is not None:
+    if part.normals is not None and not mesh_bridge.repeats_corners(part.mesh.faces):
         mesh_bridge.set_normals(obj, part.normals)
     if skeleton is not None and part.skin is not None:
         mesh_bridge.set_vertex_groups(obj, skeleton.names, *part.skin)

@@ -487,13 +487,12 @@ DRESS_HUG = 0.009  # m the dress's skirt keeps off the skin at the waist and hip
 # 5 mm clear and through both 1.5 mm layers (a speck of skin on the skirt). 6 mm clear and
 # 3 mm of cloth keep its outer surface outside the knee through the stride.
 DRESS_CLEARANCE, DRESS_THICKNESS = 0.006, 0.003
-# m the skirt keeps outside the bodice's (inner) points where it covers them: its cloth
-# and 2.5 mm. At 1 cm it stood 14-15 mm off the skin over the tucked hem against 9 mm
-# above and below, a ridge round the waist (a 3-12 mm ledge in renders).
-DRESS_OVER = DRESS_THICKNESS + 0.0025
-# ... closing to DRESS_SEAM m over the bodice's points at its top edge: inside the
-# bodice's cloth, so the bodice's surface runs on into the skirt's as across a sewn
-# waist seam (at 2.5 mm the skirt's edge stood 3-6 mm proud of the bodice, a ledge).
+# m the skirt keeps outside the bodice's (inner) points wherever it covers them: inside the
+# bodice's cloth, so the skirt's surface runs on from the bodice's, its top edge 1.5 mm
+# proud of it as across a sewn waist seam (at 2.5 mm it stood 3-6 mm proud, a ledge). Kept
+# 2.5 mm outside the bodice's cloth lower down and closing to this over its top 2.5 cm,
+# the skirt's top sloped in to its edge 10-13 degrees steeper than the bodice ran on
+# above it: from behind, a dark band and a step across the small of the back.
 DRESS_SEAM = 0.0015
 _dress_bodice_back = strapped(0.10, armhole=0.056, front=0.09, back=0.07)
 _dress_bodice_front = strapped(0.07, armhole=0.056, front=0.09, back=0.07)
@@ -520,7 +519,7 @@ def _dress(body: AuthoringBody) -> Piece:
     # The skirt's top lies over the bodice's hem (the bodice keeps 4 mm), sits on the hips
     # and flares below them.
     skirt_piece = _skirt(body, body.marks.knee[0, 2] - 0.12, _skirt_ease(body, 0.014, 0.04),
-                         hug=DRESS_HUG, under=bodice.vertices, gap=DRESS_OVER,
+                         hug=DRESS_HUG, under=bodice.vertices, gap=DRESS_SEAM,
                          edge_gap=DRESS_SEAM)  # fmt: skip
     waist = float(body.marks.hip[:, 2].mean()) + DRESS_WAIST
     return join([bound(body, bodice, faces), _waist_bound(body, skirt_piece, faces, waist)])

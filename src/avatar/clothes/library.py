@@ -19,6 +19,8 @@ from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
+
 from avatar.body.model import BodyModel
 from avatar.body.shaped import Body, default_body
 from avatar.clothes import builtin, disk_cache, fitting, variants
@@ -28,6 +30,7 @@ from avatar.clothes.fitting import FittedGarment, Garment, Outfit
 from avatar.clothes.scan import LibraryEntry, scan
 from avatar.clothes.scan import entry as scan_entry
 from avatar.errors import AvatarError, unknown_name
+from avatar.geometry.shell import layer_normals
 from avatar.part import MeshPart
 
 ENV_PATH = "AVATAR_CLOTHES_PATH"
@@ -371,7 +374,16 @@ def parts(outfit: Outfit) -> list[MeshPart]:
 
 def garment_part(g: FittedGarment) -> MeshPart:
     """One fitted garment as a MeshPart for exporters and the Blender bridge."""
-    return MeshPart(g.name, g.mesh, g.material, (g.weights.indices, g.weights.weights))
+    return MeshPart(g.name, g.mesh, g.material, (g.weights.indices, g.weights.weights),
+                    normals=garment_normals(g, g.mesh.vertices))  # fmt: skip
+
+
+def garment_normals(g: FittedGarment, vertices: np.ndarray) -> np.ndarray | None:
+    """(M, 3) float32 shading normals of a fitted garment at ``vertices`` (M, 3) (its rest
+    or a posed frame): a shell's from its cloth layers alone (``shell.layer_normals``), so
+    its hems read as edges, not as a roll; None (the renderer's own) without a shell."""
+    shell = g.garment.shell
+    return None if shell is None else layer_normals(shell, vertices)
 
 
 __all__ = [
@@ -384,6 +396,7 @@ __all__ = [
     "entry_of",
     "find_garment",
     "find_reference",
+    "garment_normals",
     "garment_part",
     "list_garments",
     "load_garment",
