@@ -24,7 +24,7 @@ CARDIGAN = ("tshirt", "cardigan", "skirt", "leggings")
 HOODIE = ("hoodie", "sweatpants")
 SETS = {"hems": [(BODIES[body], outfit) for outfit in (CARDIGAN, HOODIE)
                  for body in ("woman", "heavy", "child")]}  # fmt: skip
-FRAMING = {"hems": (0.62, 1.1, 0.86)}  # metres apart, frame height per body, aim height (m)
+FRAMING = {"hems": (0.62, 1.75, 0.92)}  # metres apart, frame height per body, aim height (m)
 
 
 def stack(before: str, after: str, out: str) -> None:
