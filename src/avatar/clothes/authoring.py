@@ -606,24 +606,31 @@ def boundary_loops(faces: np.ndarray) -> list[np.ndarray]:
     return [rim[label == k] for k in range(count)]
 
 
-def level_hems(mesh: Mesh, reach: float = 0.035, flat: float = 0.1) -> Mesh:
+def level_hems(mesh: Mesh, reach: float = 0.035, flat: float = 0.1,
+               open_front: bool = False) -> Mesh:  # fmt: skip
     """The mesh with each nearly flat open edge (a hem, a cuff, a waist; not a scooped
     neckline or an armhole) laid on its best-fit plane, the move fading out over ``reach``
     m into the cloth: a cut that follows the helper mesh's faces wanders 5-12 mm about
     that plane, a wavy hem. ``flat``: largest RMS distance from the plane, as a share of
-    the loop's mean radius, of a loop that is levelled."""
+    the loop's mean radius, of a loop that is levelled. ``open_front``: a garment open
+    down the front, whose hem runs on up the opening and round the neck in one loop that
+    is not flat: its hem run (``hem_run``) is levelled alone."""
     v = mesh.vertices.astype(np.float64)
     shift = np.zeros_like(v)
     ends: list[np.ndarray] = []
     for loop in boundary_loops(mesh.faces):
+        if len(loop) < 8:
+            continue
+        if not _flat(v[loop], flat):
+            if not open_front:
+                continue
+            loop = hem_run(v, in_order(loop, mesh.faces))
+            if len(loop) < 8:
+                continue
         p = v[loop]
         centre = p.mean(axis=0)
         normal = np.linalg.svd(p - centre)[2][2]
-        off = (p - centre) @ normal
-        radius = np.linalg.norm(p - centre, axis=1).mean()
-        if len(loop) < 8 or np.sqrt(np.mean(off**2)) > flat * radius:
-            continue
-        shift[loop] = -off[:, None] * normal
+        shift[loop] = -((p - centre) @ normal)[:, None] * normal
         ends.append(loop)
     if not ends:
         return mesh
@@ -632,3 +639,47 @@ def level_hems(mesh: Mesh, reach: float = 0.035, flat: float = 0.1) -> Mesh:
     t = np.clip(1 - distance / reach, 0, 1)
     moved = v + (t * t * (3 - 2 * t))[:, None] * shift[rim[nearest]]
     return Mesh(moved.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
+
+
+def _flat(p: np.ndarray, flat: float) -> bool:
+    """Whether points (L, 3) lie within ``flat`` x their mean radius (RMS) of a plane."""
+    p = p - p.mean(axis=0)
+    off = p @ np.linalg.svd(p)[2][2]
+    return bool(np.sqrt(np.mean(off**2)) <= flat * np.linalg.norm(p, axis=1).mean())
+
+
+def hem_run(v: np.ndarray, loop: np.ndarray) -> np.ndarray:
+    """The vertices of a boundary ``loop`` (in order round it, over v (N, 3)) along its
+    hem: from its lowest vertex on either way while the loop runs more across than down
+    from each vertex's neighbour before to the one after (an open cardigan's hem, up to
+    the corners where it turns up the opening; over two edges, as the cut dips 5 mm into
+    the cleft of the buttocks across one short edge at the back's midline)."""
+    p = v[loop]
+    d = np.roll(p, -1, axis=0) - np.roll(p, 1, axis=0)
+    across = np.abs(d[:, 2]) < 0.5 * np.hypot(d[:, 0], d[:, 1])
+    if across.all():
+        return loop
+    n, low = len(loop), int(np.argmin(p[:, 2]))
+    last = first = low
+    while across[(last + 1) % n]:
+        last += 1
+    while across[(first - 1) % n]:
+        first -= 1
+    return loop[np.arange(first, last + 1) % n]
+
+
+def in_order(loop: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """The vertices of one open boundary ``loop`` (as ``boundary_loops`` gives them) in
+    order round it, as the faces (F, C) wind; where the rim pinches (a vertex on it twice)
+    only the part from its first vertex round to the pinch."""
+    edges, _ = boundary_edges(faces)
+    mine = np.isin(edges[:, 0], loop)
+    following = dict(zip(edges[mine, 0].tolist(), edges[mine, 1].tolist(), strict=True))
+    order = [int(loop[0])]
+    seen = set(order)
+    step = following.get(order[0], order[0])
+    while step not in seen:
+        order.append(step)
+        seen.add(step)
+        step = following.get(step, order[0])
+    return np.asarray(order, np.intp)

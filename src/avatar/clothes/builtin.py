@@ -60,31 +60,43 @@ class Spec:
     # A skirt: its skin weights ramp from the hips to the hem below the hip joints
     # (``Garment.swing_below``), so its hem bends as one curve mid-stride.
     swing: bool = False
+    # A loose top: its cloth below the waist hangs from the torso as one piece, its skin
+    # weights held at the waist and carried down to the hem (``Garment.swing_below`` at the
+    # waist). Bound to the skin under it, a cardigan's hem took 80% of its weight from the
+    # thighs: mid-stride its two halves swung with the legs (the back hem 5 cm higher on
+    # one side than the other, a torn-looking diagonal), and it zig-zagged where those
+    # weights gave way to the spine's (its front corners) or where the frames' cut to four
+    # bones kept one thigh of a hoodie's back midline vertex but not the other (a notch).
+    hang: bool = False
     # Loose trousers spanning the front of the crotch (``across_the_fly``): the bridge's
     # skin weights shared between its left and right halves (``Garment.fly_share``).
     fly: bool = False
 
 
 def _tights(body: AuthoringBody, keep_fn, ease, band: float = 0.0, snug: float | None = None,
-            bridge: bool = False, fly: bool = False) -> Piece:  # fmt: skip
+            bridge: bool = False, fly: bool = False,
+            open_front: bool = False) -> Piece:  # fmt: skip
     """A garment cut from ``helper-tights``; ``band`` > 0: a rib/hem band that wide (m)
     along every open edge (``authoring.banded``); ``snug``: m off the skin a stretch
     garment is laid at (``tailoring.hug_skin``) instead of ``ease`` off the shell;
     ``bridge``: loose cloth spanning the body's hollows (``bridged``); ``fly``: loose
-    trousers spanning the front of the crotch (``across_the_fly``)."""
+    trousers spanning the front of the crotch (``across_the_fly``); ``open_front``: cut
+    ``opened``, its hem levelled up to the opening's corners (``level_hems``)."""
     faces = body.group_faces("helper-tights")
     ff = face_features(body.vertices, faces, body.part, body.marks)
     mesh = cut(body, faces, keep_fn(ff, body.marks), ease, relax=RELAX, sided=bridge)
-    mesh = level_hems(mesh)
+    mesh = level_hems(mesh, open_front=open_front)
     if fly:
         mesh = across_the_fly(body, mesh)
     if bridge:
         mesh = spread_across(body, spanned(body, bridged(body, mesh)))
+        if open_front:  # lifted along the skin's normals, the hem dipped 2.5 mm in the cleft
+            mesh = level_hems(mesh, open_front=True)
     if snug is not None:
         points = tailoring.hug_skin(body, mesh.vertices.astype(np.float64), snug)
         mesh = Mesh(points.astype(np.float32), mesh.faces, mesh.uvs, mesh.face_uvs)
     if band:  # the band's inner edge (a staircase of whole faces) levelled as the hem is
-        mesh = level_hems(banded(mesh, band), reach=0.012)
+        mesh = level_hems(banded(mesh, band), reach=0.012, open_front=open_front)
     # A snug garment follows the skin itself on every body (the shell stands off the skin
     # by different amounts on different bodies: bound to it, the seat sagged again).
     if snug is not None:
@@ -841,8 +853,8 @@ SPECS = [
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), cuffed(sleeve_ease(0.006, 0.012), 0.002), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
     Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
-    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), cuffed(sleeve_ease(0.012, 0.01), 0.006), 0.025, bridge=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open")),  # noqa: E501
-    Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit")),  # noqa: E501
+    Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), cuffed(sleeve_ease(0.012, 0.01), 0.006), 0.025, bridge=True, open_front=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open"), hang=True),  # noqa: E501
+    Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit"), hang=True),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02), fly=True), "canvas", "khaki", 0.002, 35, ("shorts",), fly=True),  # noqa: E501
     Spec("trousers", "bottoms", lambda b: _tailored(b, "trousers", 0.97, flare(0.008, 0.02, 0.2), 1.0, "grey", 0.88), "wool", "charcoal", 0.002, 35, ("trousers", "pants", "formal"), fly=True),  # noqa: E501
     Spec("jeans", "bottoms", lambda b: _tailored(b, "jeans", 0.96, flare(0.005, 0.01, 0.3), 1.0, "yellow", 0.92), "denim", "indigo", 0.0025, 35, ("jeans", "denim", "pants"), fly=True),  # noqa: E501
@@ -882,6 +894,16 @@ def build(spec: Spec, body: AuthoringBody, texture_size: int = 1024,
     return assemble(spec, spec.make(body) if piece is None else piece, body, texture_size)
 
 
+def _swing_below(spec: Spec, body: AuthoringBody) -> float | None:
+    """m: the height on the authored mesh below which a garment's skin weights are carried
+    down its cloth (``weights.swing``): a skirt's from the hip joints, a hanging top's from
+    the waist (above the reach of the thighs' weights: at the hip joints they still made
+    half of a cardigan's hem weight there, its back hem 2.5 cm askew mid-stride)."""
+    if spec.hang:
+        return float(body.marks.waist_z)
+    return float(body.marks.hip[:, 2].mean()) if spec.swing else None
+
+
 def look(spec: Spec, layout, texture_size: int = 1024) -> Material:
     """The Material of a built-in in ``spec``'s fabric and colour; ``layout``: its piece's
     panel layout (``Piece.layout``, None for a tiled fabric). A fabric or colour variant is
@@ -916,6 +938,6 @@ def assemble(spec: Spec, piece: Piece, body: AuthoringBody, texture_size: int = 
         tags=spec.tags,
         source="builtin",
         licence="CC0 (generated by Avatar from MakeHuman's CC0 base mesh)",
-        swing_below=float(body.marks.hip[:, 2].mean()) if spec.swing else None,
+        swing_below=_swing_below(spec, body),
         fly_share=fly_share(body, piece.mesh) if spec.fly else None,
     )

@@ -46,8 +46,9 @@ class Garment:
     bone_weights: the garment's own ``.mhw`` weights, or None to transfer the body's.
     thickness: m; > 0 solidifies the surface into a shell with hems.
     collide: False for face proxies (eyebrows, eyelashes) that sit on the skin by design.
-    swing_below: m (height on the authored mesh); a skirt's transferred skin weights are
-        smoothed over its cloth below it (``weights.swing``). None: as transferred.
+    swing_below: m (height on the authored mesh); a skirt's (from the hips) or a loose
+        top's (from the waist) transferred skin weights are smoothed over its cloth below
+        it (``weights.swing``). None: as transferred.
     fly_share: (N,) loose trousers' bridge across the fly: each vertex's transferred
         weights shared this much with its mirror twin's (``weights.shared_across``).
     delete_verts: (D,) int32 base-mesh vertices the garment covers (hidden if the user asks).
