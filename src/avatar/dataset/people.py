@@ -18,6 +18,7 @@ import numpy as np
 
 from avatar.body.model import BODY_VERTICES, BodyModel
 from avatar.body.shaped import PART_GROUPS, default_body, part_vertices
+from avatar.clothes.library import garment_normals
 from avatar.dataset.sampling import WALK_FPS, WALK_SECONDS, Person
 from avatar.human import Human, Recipe
 from avatar.io import bvh
@@ -106,8 +107,10 @@ def pose_person(person: Person, model: BodyModel | None = None) -> PosedPerson:
     for part in rest_parts[:body_parts]:
         index = human.part_vertices(part.name)
         parts.append(_moved(part, posed[index], place))
-    for part, vertices in zip(rest_parts[body_parts:], garments, strict=True):
-        parts.append(_moved(part, vertices, place))
+    for part, fitted, vertices in zip(rest_parts[body_parts:], human.outfit.garments,
+                                      garments, strict=True):  # fmt: skip
+        moved = _moved(part, vertices, place)  # shading as Blender and exports have it:
+        parts.append(replace(moved, normals=garment_normals(fitted, moved.mesh.vertices)))
     joints = _apply(place, world[0][:, :3, 3])
     keypoints, depth = _keypoints(human, posed, world[0][:, :3, 3])
     return PosedPerson(person, human.to_recipe(), parts, _face_parts(human, posed, garments),
