@@ -1,7 +1,8 @@
 """Render the close-ups of the eleventh pass's top hems (docs/images/looks11_hems_*.png):
-the cardigan (over a t-shirt, skirt and leggings) and the hoodie (over sweatpants) on a
-woman, a heavy man and a child, from the hips up to the chest, at rest and mid-stride,
-with ``render_closeups``' row cameras; then before and after stacked into one picture.
+the cardigan (over a t-shirt, skirt and leggings) and the hoodie (over sweatpants) (set
+"hems"), and the jacket over a t-shirt and jeans (set "jacket"), on a woman, a heavy man
+and a child, from the hips up to the chest, at rest and mid-stride, with
+``render_closeups``' row cameras; then before and after stacked into one picture.
 
     python bench/render_looks11_hems.py hems --views front,back --walk --samples 12 --size 300 \
         --out /tmp/after        # and with PYTHONPATH at the old code, --out /tmp/before
@@ -22,9 +23,12 @@ from render_looks10_garments import BODIES  # noqa: E402
 
 CARDIGAN = ("tshirt", "cardigan", "skirt", "leggings")
 HOODIE = ("hoodie", "sweatpants")
+JACKET = ("tshirt", "jacket", "jeans")
 SETS = {"hems": [(BODIES[body], outfit) for outfit in (CARDIGAN, HOODIE)
-                 for body in ("woman", "heavy", "child")]}  # fmt: skip
-FRAMING = {"hems": (0.62, 1.75, 0.92)}  # metres apart, frame height per body, aim height (m)
+                 for body in ("woman", "heavy", "child")],
+        "jacket": [(BODIES[body], JACKET) for body in ("woman", "heavy", "child")]}  # fmt: skip
+# metres apart, frame height per body, aim height (m)
+FRAMING = {"hems": (0.62, 1.75, 0.92), "jacket": (0.62, 1.75, 0.92)}
 
 
 def stack(before: str, after: str, out: str, width: int = 1440) -> None:

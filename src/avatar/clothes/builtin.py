@@ -852,7 +852,7 @@ SPECS = [
     Spec("tshirt", "tops", lambda b: _tights(b, top(0.3), sleeve_ease(0.007, 0.02), 0.014, bridge=True), "cotton", "white", 0.0015, 40, ("t-shirt", "short sleeve", "casual")),  # noqa: E501
     Spec("longsleeve", "tops", lambda b: _tights(b, top(0.94), cuffed(sleeve_ease(0.006, 0.012), 0.002), 0.02, bridge=True), "jersey", "navy", 0.0015, 40, ("long sleeve", "shirt")),  # noqa: E501
     Spec("tanktop", "tops", lambda b: _tights(b, tank, 0.004), "jersey", "grey", 0.0012, 40, ("tank top", "vest", "sleeveless")),  # noqa: E501
-    Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open")),  # noqa: E501
+    Spec("jacket", "tops", lambda b: jacket.tailored(b, _tights(b, opened(top(0.95, neck=-0.03, hem=-0.03), 0.02), sleeve_ease(0.016, 0.01), 0.02, bridge=True, open_front=True)), "leather", "black", 0.003, 60, ("jacket", "outerwear", "open"), hang=True),  # noqa: E501
     Spec("cardigan", "tops", lambda b: _tights(b, opened(top(0.94, neck=-0.01, hem=-0.05), 0.022), cuffed(sleeve_ease(0.012, 0.01), 0.006), 0.025, bridge=True, open_front=True), "knit", "beige", 0.003, 58, ("cardigan", "knit", "elderly", "open"), hang=True),  # noqa: E501
     Spec("hoodie", "tops", _hoodie, "knit", "grey", 0.004, 55, ("hoodie", "sweater", "knit"), hang=True),  # noqa: E501
     Spec("shorts", "bottoms", lambda b: _tights(b, bottom(0.4), flare(0.007, 0.02), fly=True), "canvas", "khaki", 0.002, 35, ("shorts",), fly=True),  # noqa: E501
